@@ -1,0 +1,255 @@
+#include "rsg/json.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "rsg/error_flags.hpp"
+
+namespace rsg {
+namespace {
+
+void append_double(double value, std::string& out) {
+  if (std::isnan(value)) {
+    out += "\"nan\"";
+  } else if (std::isinf(value)) {
+    out += value > 0 ? "\"inf\"" : "\"-inf\"";
+  } else if (value == 0.0 && std::signbit(value)) {
+    out += "-0.0";  // "-0" would read back as the integer 0 and lose the sign
+  } else {
+    char buffer[32];
+    const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);  // shortest round-trip
+    out.append(buffer, end);
+  }
+}
+
+void append_unsigned(std::uint64_t value, std::string& out) {
+  char buffer[24];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  out.append(buffer, end);
+}
+
+void append_field(const FieldInfo& field, const StateValues& values, std::string& out) {
+  switch (field.type) {
+    case ElementType::kFloat64: {
+      const auto elements = values.doubles(field.id());
+      if (field.is_scalar()) {
+        append_double(elements[0], out);
+        return;
+      }
+      out += '[';
+      for (std::size_t i = 0; i < elements.size(); ++i) {
+        if (i) out += ',';
+        append_double(elements[i], out);
+      }
+      out += ']';
+      return;
+    }
+    case ElementType::kErrorSet: {
+      const std::uint64_t bits = values.integer(field.id());
+      out += '[';
+      bool first = true;
+      for (std::size_t flag = 0; flag < kErrorFlagCount; ++flag) {
+        if (!((bits >> flag) & 1U)) continue;
+        if (!first) out += ',';
+        first = false;
+        out += '"';
+        out += kErrorFlagNames[flag];
+        out += '"';
+      }
+      out += ']';
+      return;
+    }
+    case ElementType::kUInt8:
+    case ElementType::kUInt64:
+      append_unsigned(values.integer(field.id()), out);
+      return;
+  }
+}
+
+using Json = nlohmann::json;
+
+bool read_unsigned(const Json& node, std::uint64_t max, std::uint64_t& out) {
+  if (!node.is_number_unsigned() && !(node.is_number_integer() && node.get<std::int64_t>() >= 0)) return false;
+  out = node.get<std::uint64_t>();
+  return out <= max;
+}
+
+bool read_double(const Json& node, double& out) {
+  if (node.is_number()) {
+    out = node.get<double>();
+    return true;
+  }
+  if (!node.is_string()) return false;
+  const auto& text = node.get_ref<const std::string&>();
+  if (text == "nan") out = std::numeric_limits<double>::quiet_NaN();
+  else if (text == "inf") out = std::numeric_limits<double>::infinity();
+  else if (text == "-inf") out = -std::numeric_limits<double>::infinity();
+  else return false;
+  return true;
+}
+
+bool read_field(const FieldInfo& field, const Json& node, StateValues& out, std::string& error) {
+  const std::string name(field.name);
+  switch (field.type) {
+    case ElementType::kFloat64: {
+      auto elements = out.doubles(field.id());
+      if (field.is_scalar()) {
+        if (read_double(node, elements[0])) return true;
+        error = name + ": expected a number or \"nan\"/\"inf\"/\"-inf\"";
+        return false;
+      }
+      if (!node.is_array() || node.size() != field.count) {
+        error = name + ": expected an array of " + std::to_string(field.count) + " numbers";
+        return false;
+      }
+      for (std::size_t i = 0; i < elements.size(); ++i) {
+        if (!read_double(node[i], elements[i])) {
+          error = name + "[" + std::to_string(i) + "]: expected a number or \"nan\"/\"inf\"/\"-inf\"";
+          return false;
+        }
+      }
+      return true;
+    }
+    case ElementType::kErrorSet: {
+      if (!node.is_array()) {
+        error = name + ": expected an array of error flag names";
+        return false;
+      }
+      std::uint64_t bits = 0;
+      for (const Json& flag : node) {
+        const auto* text = flag.is_string() ? &flag.get_ref<const std::string&>() : nullptr;
+        std::size_t bit = 0;
+        while (text && bit < kErrorFlagCount && kErrorFlagNames[bit] != *text) ++bit;
+        if (!text || bit == kErrorFlagCount) {
+          error = name + ": " + flag.dump() + " is not an error flag name";
+          return false;
+        }
+        bits |= std::uint64_t{1} << bit;
+      }
+      out.set_integer(field.id(), bits);
+      return true;
+    }
+    case ElementType::kUInt8:
+    case ElementType::kUInt64: {
+      const std::uint64_t max = field.type == ElementType::kUInt8 ? 0xFF : std::numeric_limits<std::uint64_t>::max();
+      std::uint64_t value = 0;
+      if (!read_unsigned(node, max, value)) {
+        error = name + ": expected an unsigned integer up to " + std::to_string(max);
+        return false;
+      }
+      out.set_integer(field.id(), value);
+      return true;
+    }
+  }
+  return false;
+}
+
+bool read_header(const Json& root, StateValues& out, std::string& error) {
+  std::uint64_t value = 0;
+  if (!root.contains("packet_number") || !read_unsigned(root["packet_number"], 15, value)) {
+    error = "packet_number: expected an integer 0..15";
+    return false;
+  }
+  out.packet_number = static_cast<std::uint8_t>(value);
+  if (!root.contains("group_select") || !read_unsigned(root["group_select"], 255, value)) {
+    error = "group_select: expected an integer 0..255";
+    return false;
+  }
+  out.selection.group_select = static_cast<std::uint8_t>(value);
+  const Json* data_select = root.contains("data_select") ? &root["data_select"] : nullptr;
+  if (!data_select || !data_select->is_array() || data_select->size() != kGroupCount) {
+    error = "data_select: expected an array of 6 integers 0..255";
+    return false;
+  }
+  for (std::size_t group = 0; group < kGroupCount; ++group) {
+    if (!read_unsigned((*data_select)[group], 255, value)) {
+      error = "data_select[" + std::to_string(group) + "]: expected an integer 0..255";
+      return false;
+    }
+    out.selection.data_select[group] = static_cast<std::uint8_t>(value);
+  }
+  return true;
+}
+
+}  // namespace
+
+void append_canonical_json(const StateValues& values, std::string& out) {
+  out += "{\"packet_number\":";
+  append_unsigned(values.packet_number, out);
+  out += ",\"group_select\":";
+  append_unsigned(values.selection.group_select, out);
+  out += ",\"data_select\":[";
+  for (std::size_t group = 0; group < kGroupCount; ++group) {
+    if (group) out += ',';
+    append_unsigned(values.selection.data_select[group], out);
+  }
+  out += "],\"fields\":{";
+  bool first = true;
+  for (const FieldInfo& field : kFields) {
+    if (!values.selection.contains(field.id())) continue;
+    if (!first) out += ',';
+    first = false;
+    out += '"';
+    out += field.name;
+    out += "\":";
+    append_field(field, values, out);
+  }
+  out += "}}";
+}
+
+std::string to_canonical_json(const StateValues& values) {
+  std::string out;
+  append_canonical_json(values, out);
+  return out;
+}
+
+bool parse_canonical_json(std::string_view text, StateValues& out, std::string& error) {
+  Json root;
+  try {
+    root = Json::parse(text);
+  } catch (const Json::parse_error& e) {
+    error = std::string("malformed JSON: ") + e.what();
+    return false;
+  }
+  if (!root.is_object()) {
+    error = "expected a JSON object";
+    return false;
+  }
+  for (const auto& [key, value] : root.items()) {
+    if (key != "packet_number" && key != "group_select" && key != "data_select" && key != "fields") {
+      error = "unknown key '" + key + "'";
+      return false;
+    }
+  }
+  StateValues values;
+  if (!read_header(root, values, error)) return false;
+  if (!root.contains("fields") || !root["fields"].is_object()) {
+    error = "fields: expected an object";
+    return false;
+  }
+  const Json& fields = root["fields"];
+  for (const auto& [key, value] : fields.items()) {
+    const auto field = find_field(key);
+    if (!field) {
+      error = "fields: '" + key + "' is not a field name of PROTOCOL.md";
+      return false;
+    }
+    if (!values.selection.contains(*field)) {
+      error = "fields: '" + key + "' is not selected by data_select";
+      return false;
+    }
+    if (!read_field(info(*field), value, values, error)) return false;
+  }
+  for (const FieldInfo& field : kFields) {
+    if (values.selection.contains(field.id()) && !fields.contains(field.name)) {
+      error = "fields: '" + std::string(field.name) + "' is selected by data_select but missing";
+      return false;
+    }
+  }
+  out = values;
+  return true;
+}
+
+}  // namespace rsg

@@ -1,0 +1,39 @@
+// Loads the conformance vectors copied from ../shared/vectors into tests/data/vectors.
+#pragma once
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "rsg/hex.hpp"
+
+namespace rsg::test {
+
+struct Vector {
+  std::vector<std::uint8_t> frame;
+  nlohmann::json expected;  ///< `decoded` for valid vectors, `error` for invalid ones
+  std::string decoded_text; ///< `decoded` re-serialised, for parse_canonical_json
+};
+
+inline std::vector<Vector> load_vectors(const std::string& file, const char* key) {
+  std::ifstream in(std::string(RSG_TEST_DATA_DIR) + "/vectors/" + file);
+  if (!in) throw std::runtime_error("cannot open vectors/" + file);
+  std::vector<Vector> vectors;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty()) continue;
+    const auto json = nlohmann::json::parse(line);
+    Vector vector;
+    if (!from_hex(json.at("frame_hex").get<std::string>(), vector.frame)) throw std::runtime_error("bad hex");
+    vector.expected = json.at(key);
+    vector.decoded_text = vector.expected.dump();
+    vectors.push_back(std::move(vector));
+  }
+  return vectors;
+}
+
+inline std::vector<Vector> valid_vectors() { return load_vectors("valid.jsonl", "decoded"); }
+inline std::vector<Vector> invalid_vectors() { return load_vectors("invalid.jsonl", "error"); }
+
+}  // namespace rsg::test

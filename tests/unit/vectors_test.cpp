@@ -1,0 +1,68 @@
+// Every conformance vector: decode by value, encode byte-exact, invalid category exact.
+#include <gtest/gtest.h>
+
+#include "rsg/crc32.hpp"
+#include "rsg/frame.hpp"
+#include "rsg/json.hpp"
+#include "rsg/state_values.hpp"
+#include "vectors.hpp"
+
+namespace rsg {
+namespace {
+
+TEST(Vectors, AreAllThere) {
+  EXPECT_EQ(test::valid_vectors().size(), 94U);
+  EXPECT_EQ(test::invalid_vectors().size(), 29U);
+}
+
+TEST(Vectors, ValidFramesDecodeToTheExpectedValues) {
+  for (const auto& vector : test::valid_vectors()) {
+    SCOPED_TRACE(vector.decoded_text.substr(0, 120));
+    const DecodeResult result = decode(vector.frame);
+    ASSERT_TRUE(result) << result.error().message();
+    StateValues decoded;
+    decoded.assign(result.frame());
+
+    StateValues expected;
+    std::string error;
+    ASSERT_TRUE(parse_canonical_json(vector.decoded_text, expected, error)) << error;
+    EXPECT_EQ(decoded, expected);  // bit-exact, so -0.0 keeps its sign
+
+    // Our JSON says the same, compared by value as the spec asks.
+    EXPECT_EQ(nlohmann::json::parse(to_canonical_json(decoded)), vector.expected);
+  }
+}
+
+TEST(Vectors, ValidFramesEncodeByteForByte) {
+  for (const auto& vector : test::valid_vectors()) {
+    SCOPED_TRACE(vector.decoded_text.substr(0, 120));
+    StateValues values;
+    std::string error;
+    ASSERT_TRUE(parse_canonical_json(vector.decoded_text, values, error)) << error;
+    std::array<std::uint8_t, kMaxFrameBytes> out{};
+    const EncodeResult result =
+        encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), out);
+    ASSERT_TRUE(result) << result.error.message();
+    EXPECT_EQ(std::vector<std::uint8_t>(out.begin(), out.begin() + static_cast<long>(result.size)), vector.frame);
+  }
+}
+
+TEST(Vectors, InvalidFramesFailWithTheSpecCategory) {
+  for (const auto& vector : test::invalid_vectors()) {
+    const auto expected = parse_error_category(vector.expected.get<std::string>());
+    ASSERT_TRUE(expected.has_value());
+    const DecodeResult result = decode(vector.frame);
+    ASSERT_FALSE(result);
+    EXPECT_EQ(result.error().category(), *expected)
+        << "got " << to_string(result.error().category()) << ": " << result.error().message();
+    EXPECT_FALSE(result.error().message().empty());
+  }
+}
+
+TEST(Crc32, MatchesTheZlibCheckValue) {
+  const std::string check = "123456789";
+  EXPECT_EQ(crc32({reinterpret_cast<const std::uint8_t*>(check.data()), check.size()}), 0xCBF43926U);
+}
+
+}  // namespace
+}  // namespace rsg
