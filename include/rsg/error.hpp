@@ -24,8 +24,8 @@ enum class ErrorCategory : std::uint8_t {
 inline constexpr std::size_t kErrorCategoryCount = 7;  // excluding kNone
 
 inline constexpr std::array<std::string_view, kErrorCategoryCount + 1> kErrorCategoryNames = {
-    "none",         "truncated",          "length_mismatch", "bad_crc",
-    "bad_request",  "reserved_bits",      "selection_mismatch", "bad_value"};
+    "none",        "truncated",     "length_mismatch",    "bad_crc",
+    "bad_request", "reserved_bits", "selection_mismatch", "bad_value"};
 
 constexpr std::string_view to_string(ErrorCategory category) {
   return kErrorCategoryNames[static_cast<std::size_t>(category)];

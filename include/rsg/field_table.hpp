@@ -24,50 +24,50 @@ enum class ElementType : std::uint8_t {
 };
 
 // X(name, index, group, mask, element type, count, wire bytes) -- copied from PROTOCOL.md.
-#define RSG_FIELDS(X)                                     \
-  X(O_T_EE, 0, 0, 0x01, kFloat64, 16, 128)                \
-  X(O_T_EE_d, 1, 0, 0x02, kFloat64, 16, 128)              \
-  X(F_T_EE, 2, 0, 0x04, kFloat64, 16, 128)                \
-  X(EE_T_K, 3, 0, 0x08, kFloat64, 16, 128)                \
-  X(m_ee, 4, 0, 0x10, kFloat64, 1, 8)                     \
-  X(I_ee, 5, 0, 0x20, kFloat64, 9, 72)                    \
-  X(F_x_Cee, 6, 0, 0x40, kFloat64, 3, 24)                 \
-  X(m_load, 7, 0, 0x80, kFloat64, 1, 8)                   \
-  X(I_load, 8, 1, 0x01, kFloat64, 9, 72)                  \
-  X(F_x_Cload, 9, 1, 0x02, kFloat64, 3, 24)               \
-  X(m_total, 10, 1, 0x04, kFloat64, 1, 8)                 \
-  X(I_total, 11, 1, 0x08, kFloat64, 9, 72)                \
-  X(F_x_Ctotal, 12, 1, 0x10, kFloat64, 3, 24)             \
-  X(elbow, 13, 1, 0x20, kFloat64, 2, 16)                  \
-  X(elbow_d, 14, 1, 0x40, kFloat64, 2, 16)                \
-  X(elbow_c, 15, 1, 0x80, kFloat64, 2, 16)                \
-  X(delbow_c, 16, 2, 0x01, kFloat64, 2, 16)               \
-  X(ddelbow_c, 17, 2, 0x02, kFloat64, 2, 16)              \
-  X(tau_J, 18, 2, 0x04, kFloat64, 7, 56)                  \
-  X(tau_J_d, 19, 2, 0x08, kFloat64, 7, 56)                \
-  X(dtau_J, 20, 2, 0x10, kFloat64, 7, 56)                 \
-  X(q, 21, 2, 0x20, kFloat64, 7, 56)                      \
-  X(q_d, 22, 2, 0x40, kFloat64, 7, 56)                    \
-  X(dq, 23, 2, 0x80, kFloat64, 7, 56)                     \
-  X(dq_d, 24, 3, 0x01, kFloat64, 7, 56)                   \
-  X(ddq_d, 25, 3, 0x02, kFloat64, 7, 56)                  \
-  X(joint_contact, 26, 3, 0x04, kFloat64, 7, 56)          \
-  X(cartesian_contact, 27, 3, 0x08, kFloat64, 6, 48)      \
-  X(joint_collision, 28, 3, 0x10, kFloat64, 7, 56)        \
-  X(cartesian_collision, 29, 3, 0x20, kFloat64, 6, 48)    \
-  X(tau_ext_hat_filtered, 30, 3, 0x40, kFloat64, 7, 56)   \
-  X(O_F_ext_hat_K, 31, 3, 0x80, kFloat64, 6, 48)          \
-  X(K_F_ext_hat_K, 32, 4, 0x01, kFloat64, 6, 48)          \
-  X(O_dP_EE_d, 33, 4, 0x02, kFloat64, 6, 48)              \
-  X(O_T_EE_c, 34, 4, 0x04, kFloat64, 16, 128)             \
-  X(O_dP_EE_c, 35, 4, 0x08, kFloat64, 6, 48)              \
-  X(O_ddP_EE_c, 36, 4, 0x10, kFloat64, 6, 48)             \
-  X(theta, 37, 4, 0x20, kFloat64, 7, 56)                  \
-  X(dtheta, 38, 4, 0x40, kFloat64, 7, 56)                 \
-  X(current_errors, 39, 4, 0x80, kErrorSet, 1, 5)         \
-  X(last_motion_errors, 40, 5, 0x01, kErrorSet, 1, 5)     \
+#define RSG_FIELDS(X)                                          \
+  X(O_T_EE, 0, 0, 0x01, kFloat64, 16, 128)                     \
+  X(O_T_EE_d, 1, 0, 0x02, kFloat64, 16, 128)                   \
+  X(F_T_EE, 2, 0, 0x04, kFloat64, 16, 128)                     \
+  X(EE_T_K, 3, 0, 0x08, kFloat64, 16, 128)                     \
+  X(m_ee, 4, 0, 0x10, kFloat64, 1, 8)                          \
+  X(I_ee, 5, 0, 0x20, kFloat64, 9, 72)                         \
+  X(F_x_Cee, 6, 0, 0x40, kFloat64, 3, 24)                      \
+  X(m_load, 7, 0, 0x80, kFloat64, 1, 8)                        \
+  X(I_load, 8, 1, 0x01, kFloat64, 9, 72)                       \
+  X(F_x_Cload, 9, 1, 0x02, kFloat64, 3, 24)                    \
+  X(m_total, 10, 1, 0x04, kFloat64, 1, 8)                      \
+  X(I_total, 11, 1, 0x08, kFloat64, 9, 72)                     \
+  X(F_x_Ctotal, 12, 1, 0x10, kFloat64, 3, 24)                  \
+  X(elbow, 13, 1, 0x20, kFloat64, 2, 16)                       \
+  X(elbow_d, 14, 1, 0x40, kFloat64, 2, 16)                     \
+  X(elbow_c, 15, 1, 0x80, kFloat64, 2, 16)                     \
+  X(delbow_c, 16, 2, 0x01, kFloat64, 2, 16)                    \
+  X(ddelbow_c, 17, 2, 0x02, kFloat64, 2, 16)                   \
+  X(tau_J, 18, 2, 0x04, kFloat64, 7, 56)                       \
+  X(tau_J_d, 19, 2, 0x08, kFloat64, 7, 56)                     \
+  X(dtau_J, 20, 2, 0x10, kFloat64, 7, 56)                      \
+  X(q, 21, 2, 0x20, kFloat64, 7, 56)                           \
+  X(q_d, 22, 2, 0x40, kFloat64, 7, 56)                         \
+  X(dq, 23, 2, 0x80, kFloat64, 7, 56)                          \
+  X(dq_d, 24, 3, 0x01, kFloat64, 7, 56)                        \
+  X(ddq_d, 25, 3, 0x02, kFloat64, 7, 56)                       \
+  X(joint_contact, 26, 3, 0x04, kFloat64, 7, 56)               \
+  X(cartesian_contact, 27, 3, 0x08, kFloat64, 6, 48)           \
+  X(joint_collision, 28, 3, 0x10, kFloat64, 7, 56)             \
+  X(cartesian_collision, 29, 3, 0x20, kFloat64, 6, 48)         \
+  X(tau_ext_hat_filtered, 30, 3, 0x40, kFloat64, 7, 56)        \
+  X(O_F_ext_hat_K, 31, 3, 0x80, kFloat64, 6, 48)               \
+  X(K_F_ext_hat_K, 32, 4, 0x01, kFloat64, 6, 48)               \
+  X(O_dP_EE_d, 33, 4, 0x02, kFloat64, 6, 48)                   \
+  X(O_T_EE_c, 34, 4, 0x04, kFloat64, 16, 128)                  \
+  X(O_dP_EE_c, 35, 4, 0x08, kFloat64, 6, 48)                   \
+  X(O_ddP_EE_c, 36, 4, 0x10, kFloat64, 6, 48)                  \
+  X(theta, 37, 4, 0x20, kFloat64, 7, 56)                       \
+  X(dtheta, 38, 4, 0x40, kFloat64, 7, 56)                      \
+  X(current_errors, 39, 4, 0x80, kErrorSet, 1, 5)              \
+  X(last_motion_errors, 40, 5, 0x01, kErrorSet, 1, 5)          \
   X(control_command_success_rate, 41, 5, 0x02, kFloat64, 1, 8) \
-  X(robot_mode, 42, 5, 0x04, kUInt8, 1, 1)                \
+  X(robot_mode, 42, 5, 0x04, kUInt8, 1, 1)                     \
   X(time, 43, 5, 0x08, kUInt64, 1, 8)
 
 /// Field identifiers, in field-index order (the order fields appear in a frame).
@@ -103,11 +103,11 @@ constexpr std::uint16_t value_element_bytes(ElementType type) {
 struct FieldInfo {
   std::string_view name;
   std::uint8_t index;
-  std::uint8_t group;       ///< group_select bit / data_select byte that carries the field
-  std::uint8_t mask;        ///< bit of data_select[group]
+  std::uint8_t group;  ///< group_select bit / data_select byte that carries the field
+  std::uint8_t mask;   ///< bit of data_select[group]
   ElementType type;
-  std::uint8_t count;       ///< elements (16 for a 4x4 pose, 1 for a scalar)
-  std::uint16_t wire_bytes; ///< bytes in a frame
+  std::uint8_t count;        ///< elements (16 for a 4x4 pose, 1 for a scalar)
+  std::uint16_t wire_bytes;  ///< bytes in a frame
 
   constexpr Field id() const { return static_cast<Field>(index); }
   /// Bytes the value takes in host memory, e.g. in the IDL sample.

@@ -66,7 +66,6 @@ class DecodeResult {
   FrameError error_;
 };
 
-
 /// Copies every field of `frame` into the struct at `base` (laid out as `layout` says) and zeroes
 /// the fields the frame does not carry, so a reused sample never shows stale values.
 void copy_fields(const FrameView& frame, void* base, const FieldLayout& layout) noexcept;

@@ -39,9 +39,11 @@ FrameError check_header(std::uint8_t request, const Selection& selection) {
   if (((request >> 4) & 0x07) != kRequestType)
     return {ErrorCategory::kBadRequest, "request type is %u, expected 3", (request >> 4) & 0x07};
   if (selection.group_select & kReservedGroupBits)
-    return {ErrorCategory::kReservedBits, "group_select 0x%02x sets reserved GROUP6/GROUP7", selection.group_select};
+    return {ErrorCategory::kReservedBits, "group_select 0x%02x sets reserved GROUP6/GROUP7",
+            selection.group_select};
   if (selection.data_select[5] & kReservedDataSelectBits)
-    return {ErrorCategory::kReservedBits, "data_select[5] 0x%02x sets reserved UNDEF bits", selection.data_select[5]};
+    return {ErrorCategory::kReservedBits, "data_select[5] 0x%02x sets reserved UNDEF bits",
+            selection.data_select[5]};
   for (std::size_t group = 0; group < kGroupCount; ++group)
     if (selection.data_select[group] != 0 && !selection.has_group(group))
       return {ErrorCategory::kSelectionMismatch, "data_select[%zu] is 0x%02x but group %zu is not selected",
@@ -126,8 +128,8 @@ DecodeResult decode(std::span<const std::uint8_t> bytes) noexcept {
     offset = static_cast<std::uint16_t>(offset + field.wire_bytes);
   }
   if (offset - kHeaderBytes != length) {
-    error = {ErrorCategory::kLengthMismatch, "length field says %u data bytes, data_select implies %zu", length,
-             offset - kHeaderBytes};
+    error = {ErrorCategory::kLengthMismatch, "length field says %u data bytes, data_select implies %zu",
+             length, offset - kHeaderBytes};
     return result;
   }
   for (const FieldInfo& field : kFields) {
@@ -186,7 +188,8 @@ EncodeResult encode(std::uint8_t packet_number, const Selection& selection, cons
 EncodeResult encode_selection_request(std::uint8_t packet_number, const Selection& selection,
                                       std::span<std::uint8_t> out) noexcept {
   EncodeResult result;
-  if ((result.error = check_encodable(packet_number, selection, kSelectionRequestBytes, out.size()))) return result;
+  if ((result.error = check_encodable(packet_number, selection, kSelectionRequestBytes, out.size())))
+    return result;
   write_header(packet_number, selection, 0, out);
   write_u32(out.data() + kHeaderBytes, crc32(out.first(kHeaderBytes)));
   result.size = kSelectionRequestBytes;

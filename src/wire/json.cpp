@@ -71,7 +71,8 @@ void append_field(const FieldInfo& field, const StateValues& values, std::string
 using Json = nlohmann::json;
 
 bool read_unsigned(const Json& node, std::uint64_t max, std::uint64_t& out) {
-  if (!node.is_number_unsigned() && !(node.is_number_integer() && node.get<std::int64_t>() >= 0)) return false;
+  if (!node.is_number_unsigned() && !(node.is_number_integer() && node.get<std::int64_t>() >= 0))
+    return false;
   out = node.get<std::uint64_t>();
   return out <= max;
 }
@@ -83,10 +84,14 @@ bool read_double(const Json& node, double& out) {
   }
   if (!node.is_string()) return false;
   const auto& text = node.get_ref<const std::string&>();
-  if (text == "nan") out = std::numeric_limits<double>::quiet_NaN();
-  else if (text == "inf") out = std::numeric_limits<double>::infinity();
-  else if (text == "-inf") out = -std::numeric_limits<double>::infinity();
-  else return false;
+  if (text == "nan")
+    out = std::numeric_limits<double>::quiet_NaN();
+  else if (text == "inf")
+    out = std::numeric_limits<double>::infinity();
+  else if (text == "-inf")
+    out = -std::numeric_limits<double>::infinity();
+  else
+    return false;
   return true;
 }
 
@@ -133,7 +138,8 @@ bool read_field(const FieldInfo& field, const Json& node, StateValues& out, std:
     }
     case ElementType::kUInt8:
     case ElementType::kUInt64: {
-      const std::uint64_t max = field.type == ElementType::kUInt8 ? 0xFF : std::numeric_limits<std::uint64_t>::max();
+      const std::uint64_t max =
+          field.type == ElementType::kUInt8 ? 0xFF : std::numeric_limits<std::uint64_t>::max();
       std::uint64_t value = 0;
       if (!read_unsigned(node, max, value)) {
         error = name + ": expected an unsigned integer up to " + std::to_string(max);

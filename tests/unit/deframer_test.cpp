@@ -1,8 +1,9 @@
 // The stream deframer finds every frame however the stream is chunked and skips garbage.
+#include "rsg/deframer.hpp"
+
 #include <gtest/gtest.h>
 
 #include "random_state.hpp"
-#include "rsg/deframer.hpp"
 #include "rsg/frame.hpp"
 
 namespace rsg {
@@ -10,7 +11,8 @@ namespace {
 
 std::vector<std::uint8_t> encode_state(const StateValues& values) {
   std::vector<std::uint8_t> frame(kMaxFrameBytes);
-  const EncodeResult result = encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), frame);
+  const EncodeResult result =
+      encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), frame);
   frame.resize(result.size);
   return frame;
 }
@@ -41,7 +43,8 @@ Stream make_stream(std::mt19937_64& rng, int frames, bool with_garbage) {
   return stream;
 }
 
-std::vector<std::vector<std::uint8_t>> feed_in_chunks(Deframer& deframer, const std::vector<std::uint8_t>& bytes,
+std::vector<std::vector<std::uint8_t>> feed_in_chunks(Deframer& deframer,
+                                                      const std::vector<std::uint8_t>& bytes,
                                                       std::mt19937_64& rng, std::size_t max_chunk) {
   std::vector<std::vector<std::uint8_t>> found;
   std::size_t at = 0;

@@ -1,7 +1,7 @@
 // The table agrees with PROTOCOL.md's columns that it does not derive itself.
-#include <gtest/gtest.h>
-
 #include "rsg/field_table.hpp"
+
+#include <gtest/gtest.h>
 
 namespace rsg {
 namespace {

@@ -1,9 +1,9 @@
 // Canonical JSON: the spec's example, special values, and clear errors for bad input.
+#include "rsg/json.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "rsg/json.hpp"
 
 namespace rsg {
 namespace {
@@ -37,8 +37,10 @@ TEST(Json, SpecialValuesAndScalars) {
   const std::string json = to_canonical_json(values);
   EXPECT_NE(json.find(R"("m_ee":-0.0)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("q":["nan","inf","-inf",8,0,0,0])"), std::string::npos) << json;
-  EXPECT_NE(json.find(R"("current_errors":["joint_position_limits_violation","self_collision_avoidance_violation"])"),
-            std::string::npos);
+  EXPECT_NE(
+      json.find(
+          R"("current_errors":["joint_position_limits_violation","self_collision_avoidance_violation"])"),
+      std::string::npos);
   EXPECT_NE(json.find(R"("time":18446744073709551615)"), std::string::npos);
 
   StateValues parsed;
@@ -67,18 +69,22 @@ INSTANTIATE_TEST_SUITE_P(
     Json, JsonErrors,
     testing::Values(
         BadInput{"{", "malformed JSON"}, BadInput{"[]", "expected a JSON object"},
-        BadInput{R"({"packet_number":16,"group_select":0,"data_select":[0,0,0,0,0,0],"fields":{}})", "packet_number"},
-        BadInput{R"({"packet_number":1,"group_select":0,"data_select":[0,0,0,0,0],"fields":{}})", "data_select"},
+        BadInput{R"({"packet_number":16,"group_select":0,"data_select":[0,0,0,0,0,0],"fields":{}})",
+                 "packet_number"},
+        BadInput{R"({"packet_number":1,"group_select":0,"data_select":[0,0,0,0,0],"fields":{}})",
+                 "data_select"},
         BadInput{R"({"packet_number":1,"group_select":4,"data_select":[0,0,32,0,0,0],"fields":{}})",
                  "'q' is selected by data_select but missing"},
         BadInput{R"({"packet_number":1,"group_select":4,"data_select":[0,0,32,0,0,0],"fields":{"q":[1]}})",
                  "q: expected an array of 7 numbers"},
         BadInput{R"({"packet_number":1,"group_select":0,"data_select":[0,0,0,0,0,0],"fields":{"qq":1}})",
                  "'qq' is not a field name"},
-        BadInput{R"({"packet_number":1,"group_select":0,"data_select":[0,0,0,0,0,0],"fields":{"q":[1,2,3,4,5,6,7]}})",
-                 "'q' is not selected"},
-        BadInput{R"({"packet_number":1,"group_select":16,"data_select":[0,0,0,0,128,0],"fields":{"current_errors":["nope"]}})",
-                 "not an error flag name"},
+        BadInput{
+            R"({"packet_number":1,"group_select":0,"data_select":[0,0,0,0,0,0],"fields":{"q":[1,2,3,4,5,6,7]}})",
+            "'q' is not selected"},
+        BadInput{
+            R"({"packet_number":1,"group_select":16,"data_select":[0,0,0,0,128,0],"fields":{"current_errors":["nope"]}})",
+            "not an error flag name"},
         BadInput{R"({"packet_number":1,"group_select":0,"data_select":[0,0,0,0,0,0],"fields":{},"extra":1})",
                  "unknown key 'extra'"}));
 

@@ -1,8 +1,9 @@
 // Selections, field lists and the spec's selection-request frame.
+#include "rsg/selection.hpp"
+
 #include <gtest/gtest.h>
 
 #include "rsg/frame.hpp"
-#include "rsg/selection.hpp"
 
 namespace rsg {
 namespace {
@@ -69,7 +70,7 @@ TEST(Encode, RefusesWhatADecoderWouldReject) {
   Selection selection;
   selection.add(Field::robot_mode);
   std::array<std::uint8_t, 64> storage{};  // zeroed host values; robot_mode patched below
-  FieldLayout layout;  // every field at offset 0 of `storage`
+  FieldLayout layout;                      // every field at offset 0 of `storage`
   std::array<std::uint8_t, kMaxFrameBytes> out{};
   storage[0] = 7;
   EXPECT_EQ(encode(0, selection, storage.data(), layout, out).error.category(), ErrorCategory::kBadValue);
@@ -88,7 +89,8 @@ TEST(Encode, RefusesWhatADecoderWouldReject) {
 
   Selection mismatched;
   mismatched.data_select[1] = 1;
-  EXPECT_EQ(encode(0, mismatched, storage.data(), layout, out).error.category(), ErrorCategory::kSelectionMismatch);
+  EXPECT_EQ(encode(0, mismatched, storage.data(), layout, out).error.category(),
+            ErrorCategory::kSelectionMismatch);
 }
 
 }  // namespace

@@ -13,8 +13,8 @@ namespace rsg::test {
 
 struct Vector {
   std::vector<std::uint8_t> frame;
-  nlohmann::json expected;  ///< `decoded` for valid vectors, `error` for invalid ones
-  std::string decoded_text; ///< `decoded` re-serialised, for parse_canonical_json
+  nlohmann::json expected;   ///< `decoded` for valid vectors, `error` for invalid ones
+  std::string decoded_text;  ///< `decoded` re-serialised, for parse_canonical_json
 };
 
 inline std::vector<Vector> load_vectors(const std::string& file, const char* key) {

@@ -1,11 +1,12 @@
 // Every conformance vector: decode by value, encode byte-exact, invalid category exact.
+#include "vectors.hpp"
+
 #include <gtest/gtest.h>
 
 #include "rsg/crc32.hpp"
 #include "rsg/frame.hpp"
 #include "rsg/json.hpp"
 #include "rsg/state_values.hpp"
-#include "vectors.hpp"
 
 namespace rsg {
 namespace {
@@ -43,7 +44,8 @@ TEST(Vectors, ValidFramesEncodeByteForByte) {
     const EncodeResult result =
         encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), out);
     ASSERT_TRUE(result) << result.error.message();
-    EXPECT_EQ(std::vector<std::uint8_t>(out.begin(), out.begin() + static_cast<long>(result.size)), vector.frame);
+    EXPECT_EQ(std::vector<std::uint8_t>(out.begin(), out.begin() + static_cast<long>(result.size)),
+              vector.frame);
   }
 }
 

@@ -1,0 +1,129 @@
+#include "rsg/udp_socket.hpp"
+
+#include <arpa/inet.h>
+#include <netdb.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+#include <system_error>
+
+namespace rsg {
+
+Endpoint Endpoint::parse(std::string_view host_port) {
+  const std::string text(host_port);
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon + 1 == text.size())
+    throw std::invalid_argument("'" + text + "' is not HOST:PORT");
+  std::string host = text.substr(0, colon);
+  const std::string port = text.substr(colon + 1);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  if (host.empty() || host == "*") host = "0.0.0.0";
+
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_DGRAM;
+  hints.ai_flags = AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  if (const int status = ::getaddrinfo(host.c_str(), port.c_str(), &hints, &found); status != 0)
+    throw std::invalid_argument("'" + text + "': " + ::gai_strerror(status));
+  Endpoint endpoint;
+  std::memcpy(&endpoint.storage_, found->ai_addr, found->ai_addrlen);
+  endpoint.size_ = static_cast<socklen_t>(found->ai_addrlen);
+  ::freeaddrinfo(found);
+  return endpoint;
+}
+
+std::uint16_t Endpoint::port() const {
+  if (family() == AF_INET) return ntohs(reinterpret_cast<const sockaddr_in*>(&storage_)->sin_port);
+  if (family() == AF_INET6) return ntohs(reinterpret_cast<const sockaddr_in6*>(&storage_)->sin6_port);
+  return 0;
+}
+
+std::string Endpoint::to_string() const {
+  char host[INET6_ADDRSTRLEN] = "?";
+  if (family() == AF_INET) {
+    ::inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(&storage_)->sin_addr, host, sizeof host);
+    return std::string(host) + ":" + std::to_string(port());
+  }
+  if (family() == AF_INET6) {
+    ::inet_ntop(AF_INET6, &reinterpret_cast<const sockaddr_in6*>(&storage_)->sin6_addr, host, sizeof host);
+    return "[" + std::string(host) + "]:" + std::to_string(port());
+  }
+  return "(none)";
+}
+
+bool operator==(const Endpoint& a, const Endpoint& b) {
+  return a.size_ == b.size_ && std::memcmp(&a.storage_, &b.storage_, a.size_) == 0;
+}
+
+UdpSocket UdpSocket::bind(const Endpoint& local) {
+  const int fd = ::socket(local.family(), SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) throw std::system_error(errno, std::generic_category(), "socket()");
+  UdpSocket socket(fd);
+  const int yes = 1;
+  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  if (::bind(fd, local.address(), local.size()) != 0)
+    throw std::system_error(errno, std::generic_category(), "cannot bind UDP " + local.to_string());
+  return socket;
+}
+
+UdpSocket UdpSocket::for_sending_to(const Endpoint& peer) {
+  const int fd = ::socket(peer.family(), SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) throw std::system_error(errno, std::generic_category(), "socket()");
+  return UdpSocket(fd);
+}
+
+UdpSocket::UdpSocket(UdpSocket&& other) noexcept : fd_(other.fd_) { other.fd_ = -1; }
+
+UdpSocket& UdpSocket::operator=(UdpSocket&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = other.fd_;
+    other.fd_ = -1;
+  }
+  return *this;
+}
+
+UdpSocket::~UdpSocket() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+std::optional<std::size_t> UdpSocket::receive(std::span<std::uint8_t> buffer, Endpoint* from,
+                                              std::chrono::milliseconds timeout) {
+  pollfd waiting{fd_, POLLIN, 0};
+  if (::poll(&waiting, 1, static_cast<int>(timeout.count())) <= 0) return std::nullopt;
+  Endpoint ignored;
+  Endpoint& source = from ? *from : ignored;
+  socklen_t size = source.capacity();
+  // MSG_TRUNC makes the kernel report the real datagram size, so oversized input is detectable.
+  const ssize_t received = ::recvfrom(fd_, buffer.data(), buffer.size(), MSG_TRUNC, source.address(), &size);
+  if (received < 0) return std::nullopt;
+  source.set_size(size);
+  return static_cast<std::size_t>(received);
+}
+
+bool UdpSocket::send_to(std::span<const std::uint8_t> datagram, const Endpoint& to) {
+  return ::sendto(fd_, datagram.data(), datagram.size(), 0, to.address(), to.size()) ==
+         static_cast<ssize_t>(datagram.size());
+}
+
+int UdpSocket::set_receive_buffer(int bytes) {
+  ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &bytes, sizeof bytes);
+  int granted = 0;
+  socklen_t size = sizeof granted;
+  ::getsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &granted, &size);
+  return granted;
+}
+
+Endpoint UdpSocket::local_endpoint() const {
+  Endpoint endpoint;
+  socklen_t size = endpoint.capacity();
+  ::getsockname(fd_, endpoint.address(), &size);
+  endpoint.set_size(size);
+  return endpoint;
+}
+
+}  // namespace rsg
