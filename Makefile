@@ -45,7 +45,7 @@ test: build
 	$(MAKE) fuzz FUZZ_SECONDS=30
 
 demo: build
-	tools/demo.sh $(BUILD)/bin
+	src/tools/demo.sh $(BUILD)/bin
 
 bench: build
 	tests/bench/run_bench.sh $(BUILD)
