@@ -1,0 +1,51 @@
+#include "rsg/profiles.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <stdexcept>
+#include <vector>
+
+namespace rsg {
+namespace {
+
+std::filesystem::path running_binary_dir() {
+  std::error_code error;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", error);
+  return error ? std::filesystem::path() : self.parent_path();
+}
+
+}  // namespace
+
+std::filesystem::path default_profiles_dir() {
+  if (const char* env = std::getenv("RSG_PROFILES_DIR"); env && *env) return env;
+  const auto bin = running_binary_dir();
+  // Installed: <prefix>/bin + <prefix>/share/rsg/xml_profiles. Docker image: /opt/rsg/{bin,xml_profiles}.
+  for (const auto& candidate : {bin / "../share/rsg/xml_profiles", bin / "../xml_profiles"}) {
+    std::error_code error;
+    if (std::filesystem::is_directory(candidate, error)) return std::filesystem::weakly_canonical(candidate);
+  }
+  return RSG_DEFAULT_PROFILES_DIR;  // a build tree: the sources it was built from
+}
+
+void load_profiles(const std::filesystem::path& file_or_dir) {
+  std::vector<std::filesystem::path> files;
+  std::error_code error;
+  if (std::filesystem::is_directory(file_or_dir, error)) {
+    for (const auto& entry : std::filesystem::directory_iterator(file_or_dir))
+      if (entry.path().extension() == ".xml") files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
+  } else if (std::filesystem::is_regular_file(file_or_dir, error)) {
+    files.push_back(file_or_dir);
+  }
+  if (files.empty()) throw std::runtime_error(file_or_dir.string() + ": no XML profiles found");
+  auto* factory = eprosima::fastdds::dds::DomainParticipantFactory::get_instance();
+  for (const auto& file : files)
+    if (factory->load_XML_profiles_file(file.string()) != ReturnCode_t::RETCODE_OK)
+      throw std::runtime_error(file.string() +
+                               ": Fast DDS rejected this XML profile file (its log above says where)");
+}
+
+}  // namespace rsg
