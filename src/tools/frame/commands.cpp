@@ -1,0 +1,160 @@
+#include "commands.hpp"
+
+#include <array>
+#include <cstdio>
+#include <istream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rsg/frame.hpp"
+#include "rsg/hex.hpp"
+#include "rsg/json.hpp"
+#include "rsg/state_values.hpp"
+
+namespace rsg::frame_tool {
+namespace {
+
+constexpr std::string_view kWhitespace = " \t\r\n\v\f";
+
+std::string_view trim(std::string_view text) {
+  const std::size_t first = text.find_first_not_of(kWhitespace);
+  if (first == std::string_view::npos) return {};
+  return text.substr(first, text.find_last_not_of(kWhitespace) - first + 1);
+}
+
+/// Calls `on_line(number, text)` for every line that is not blank; `number` counts from 1 and
+/// includes blank lines, so that it matches what an editor shows. Stops when `on_line` is false.
+template <class OnLine>
+void for_each_nonblank_line(std::istream& in, OnLine&& on_line) {
+  std::size_t number = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++number;
+    const std::string_view text = trim(line);
+    if (!text.empty() && !on_line(number, text)) return;
+  }
+}
+
+/// Why `from_hex` refused `text`: the first non-hex character, else the odd digit count.
+std::string describe_bad_hex(std::string_view text) {
+  const std::size_t bad = text.find_first_not_of("0123456789abcdefABCDEF");
+  std::array<char, 96> message{};
+  if (bad != std::string_view::npos)
+    std::snprintf(message.data(), message.size(), "byte 0x%02x at column %zu is not a hex digit",
+                  static_cast<unsigned char>(text[bad]), bad + 1);
+  else
+    std::snprintf(message.data(), message.size(), "odd number of hex digits (%zu)", text.size());
+  return message.data();
+}
+
+std::string error_line(std::string_view category, std::string_view message) {
+  // ordered_json keeps "error" first; replace, not throw, on bytes that are not UTF-8.
+  const nlohmann::ordered_json line = {{"error", category}, {"message", message}};
+  return line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+void write_frame(std::ostream& out, std::span<const std::uint8_t> frame, FrameFormat format) {
+  if (format == FrameFormat::kHexLines) {
+    out << to_hex(frame) << '\n';
+  } else {
+    out.write(reinterpret_cast<const char*>(frame.data()), static_cast<std::streamsize>(frame.size()));
+  }
+}
+
+/// The final status once everything has been written: a write that failed (full disk, closed pipe)
+/// must not look like success.
+int finish(Streams streams, int status) {
+  streams.out.flush();
+  if (!streams.out) {
+    streams.err << "error: cannot write the output\n";
+    return kExitInvalid;
+  }
+  if (streams.in.bad()) {
+    streams.err << "error: cannot read the input\n";
+    return kExitInvalid;
+  }
+  return status;
+}
+
+}  // namespace
+
+int decode_binary(Streams streams) {
+  const std::vector<std::uint8_t> bytes(std::istreambuf_iterator<char>(streams.in), {});
+  if (streams.in.bad()) return finish(streams, kExitInvalid);
+  const DecodeResult result = decode(bytes);
+  if (!result) {
+    streams.err << "error: " << to_string(result.error().category()) << ": " << result.error().message()
+                << '\n';
+    return finish(streams, kExitInvalid);
+  }
+  StateValues values;
+  values.assign(result.frame());
+  streams.out << to_canonical_json(values) << '\n';
+  return finish(streams, kExitOk);
+}
+
+int decode_hex_lines(Streams streams) {
+  std::vector<std::uint8_t> bytes;
+  StateValues values;
+  std::string json;
+  for_each_nonblank_line(streams.in, [&](std::size_t number, std::string_view text) {
+    if (!from_hex(text, bytes)) {
+      streams.out << error_line("bad_hex", "line " + std::to_string(number) + ": " + describe_bad_hex(text))
+                  << '\n';
+      return true;
+    }
+    const DecodeResult result = decode(bytes);
+    if (!result) {
+      streams.out << error_line(to_string(result.error().category()), result.error().message()) << '\n';
+      return true;
+    }
+    values.assign(result.frame());
+    json.clear();
+    append_canonical_json(values, json);
+    streams.out << json << '\n';
+    return true;
+  });
+  return finish(streams, kExitOk);
+}
+
+int encode_json_lines(Streams streams, FrameFormat format) {
+  int status = kExitOk;
+  StateValues values;
+  std::string reason;
+  std::array<std::uint8_t, kMaxFrameBytes> frame{};
+  for_each_nonblank_line(streams.in, [&](std::size_t number, std::string_view text) {
+    if (!parse_canonical_json(text, values, reason)) {
+      streams.err << "error: line " << number << ": " << reason << '\n';
+      status = kExitInvalid;
+      return false;
+    }
+    const EncodeResult result =
+        encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), frame);
+    if (!result) {
+      streams.err << "error: line " << number << ": cannot encode: " << to_string(result.error.category())
+                  << ": " << result.error.message() << '\n';
+      status = kExitInvalid;
+      return false;
+    }
+    write_frame(streams.out, std::span(frame).first(result.size), format);
+    return true;
+  });
+  return finish(streams, status);
+}
+
+int write_selection_request(Streams streams, std::uint8_t packet_number, const Selection& selection,
+                            FrameFormat format) {
+  std::array<std::uint8_t, kSelectionRequestBytes> frame{};
+  const EncodeResult result = encode_selection_request(packet_number, selection, frame);
+  if (!result) {
+    streams.err << "error: " << to_string(result.error.category()) << ": " << result.error.message() << '\n';
+    return finish(streams, kExitInvalid);
+  }
+  write_frame(streams.out, std::span(frame).first(result.size), format);
+  return finish(streams, kExitOk);
+}
+
+}  // namespace rsg::frame_tool

@@ -1,0 +1,114 @@
+// rsg_frame: converts SEND_BUF frames between binary, hex and the spec's canonical JSON, and writes
+// selection requests. See `rsg_frame --help` and commands.hpp.
+#include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include "commands.hpp"
+
+namespace {
+
+using namespace rsg::frame_tool;
+
+/// The input a subcommand reads: the named file, or standard input for "-".
+class Input {
+ public:
+  explicit Input(const std::string& path) {
+    if (path == "-") return;
+    file_.open(path, std::ios::binary);
+    stream_ = &file_;
+  }
+  Input(const Input&) = delete;
+  Input& operator=(const Input&) = delete;
+
+  bool is_open() const { return stream_ != &file_ || file_.is_open(); }
+  std::istream& stream() { return *stream_; }
+
+ private:
+  std::ifstream file_;
+  std::istream* stream_ = &std::cin;
+};
+
+struct Options {
+  std::string input = "-";
+  bool hex_lines = false;
+  unsigned packet_number = 0;
+  rsg::Selection selection;
+};
+
+void add_input(CLI::App& command, Options& options) {
+  command.add_option("input", options.input, "File to read, - for standard input")->capture_default_str();
+}
+
+/// Adds `--groups` and `--fields`, exactly one of which fills `options.selection`. A list that does
+/// not parse is a usage error, reported by CLI11 like any other.
+void add_selection(CLI::App& command, Options& options) {
+  auto* choice = command.add_option_group("selection", "What the robot should send (exactly one)");
+  auto parse_into = [&options](auto parse, const char* option) {
+    return [&options, parse, option](const std::string& list) {
+      std::string error;
+      if (!parse(list, options.selection, error)) throw CLI::ValidationError(option, error);
+    };
+  };
+  choice->add_option_function<std::string>("--groups", parse_into(rsg::parse_group_list, "--groups"),
+                                           "Comma-separated group numbers 0..5, every field of each");
+  choice->add_option_function<std::string>("--fields", parse_into(rsg::parse_field_list, "--fields"),
+                                           "Comma-separated field names of PROTOCOL.md, e.g. q,dq,time");
+  choice->require_option(1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::ios::sync_with_stdio(false);
+
+  CLI::App app{"Converts SEND_BUF frames (PROTOCOL.md) between binary, hex and canonical JSON.", "rsg_frame"};
+  app.require_subcommand(1);
+  app.footer(
+      "Exit status: 0 success (decode --hex-lines: the input was readable), 1 invalid frame, malformed "
+      "JSON or hex, or an I/O error, 2 usage error.");
+  Options options;
+
+  auto* decode = app.add_subcommand("decode", "Binary frame, or hex frames one per line -> canonical JSON");
+  decode->add_flag("--hex-lines", options.hex_lines,
+                   "One hex frame per line; each output line is canonical JSON or "
+                   "{\"error\":CATEGORY,\"message\":...}");
+  add_input(*decode, options);
+
+  auto* encode = app.add_subcommand(
+      "encode", "Canonical JSON, one object per line -> binary frames (stops at the first bad line)");
+  encode->add_flag("--hex-lines", options.hex_lines, "Write one hex frame per line instead of binary");
+  add_input(*encode, options);
+
+  auto* request = app.add_subcommand("request", "Write a selection request (gateway -> robot)");
+  add_selection(*request, options);
+  request->add_option("--packet-number", options.packet_number, "Packet number 0..15")
+      ->check(CLI::Range(0, 15))
+      ->capture_default_str();
+  request->add_flag("--hex,--hex-lines", options.hex_lines, "Write one hex line instead of binary");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // CLI11 has a distinct code per parse error; callers only need "usage error".
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+
+  const FrameFormat format = options.hex_lines ? FrameFormat::kHexLines : FrameFormat::kBinary;
+  if (request->parsed())
+    return write_selection_request({std::cin, std::cout, std::cerr},
+                                   static_cast<std::uint8_t>(options.packet_number), options.selection,
+                                   format);
+
+  Input input(options.input);
+  if (!input.is_open()) {
+    std::cerr << "error: cannot open '" << options.input << "': " << std::strerror(errno) << '\n';
+    return kExitInvalid;
+  }
+  const Streams streams{input.stream(), std::cout, std::cerr};
+  if (encode->parsed()) return encode_json_lines(streams, format);
+  return options.hex_lines ? decode_hex_lines(streams) : decode_binary(streams);
+}
