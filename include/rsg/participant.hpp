@@ -22,7 +22,8 @@ namespace fdds = eprosima::fastdds::dds;
 
 class Participant {
  public:
-  /// Creates the participant from an XML participant profile (load_profiles first), on `domain`.
+  /// Creates the participant from an XML participant profile (load_profiles first), on `domain`;
+  /// an empty profile name means Fast DDS's default participant QoS.
   /// Throws std::runtime_error when Fast DDS refuses.
   Participant(int domain, const std::string& profile);
   ~Participant();

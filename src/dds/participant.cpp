@@ -9,8 +9,9 @@
 namespace rsg {
 
 Participant::Participant(int domain, const std::string& profile) {
-  participant_ =
-      fdds::DomainParticipantFactory::get_instance()->create_participant_with_profile(domain, profile);
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  participant_ = profile.empty() ? factory->create_participant(domain, fdds::PARTICIPANT_QOS_DEFAULT)
+                                 : factory->create_participant_with_profile(domain, profile);
   if (!participant_)
     throw std::runtime_error("cannot create DDS participant on domain " + std::to_string(domain) +
                              " with profile '" + profile + "' (are the XML profiles loaded?)");
