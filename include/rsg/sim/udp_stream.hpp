@@ -1,0 +1,44 @@
+// Runs a Simulator on the wall clock and a UDP socket: what `rsg_sim` does once its options are read.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <ostream>
+
+#include "rsg/sim/simulator.hpp"
+#include "rsg/udp_socket.hpp"
+
+namespace rsg::sim {
+
+/// Sends to one peer, and reads the selection requests that the peer (or anyone) sends back to the
+/// socket's address, which a receiver learns from the source of the datagrams.
+class UdpLink final : public DatagramSink {
+ public:
+  UdpLink(UdpSocket& socket, const Endpoint& peer) : socket_(socket), peer_(peer) {}
+
+  bool send(std::span<const std::uint8_t> datagram) override { return socket_.send_to(datagram, peer_); }
+  /// Hands every datagram waiting on the socket to `sim` as a selection request and logs the outcome.
+  void poll_requests(Simulator& sim, std::ostream& log);
+
+ private:
+  UdpSocket& socket_;
+  Endpoint peer_;
+  std::array<std::uint8_t, kMaxFrameBytes + 1> request_{};  // + 1: an oversized datagram shows as one
+};
+
+struct StreamLimits {
+  std::optional<std::uint64_t> count;                ///< stop after this many frames
+  std::optional<std::chrono::nanoseconds> duration;  ///< stop when the timeline reaches this
+};
+
+/// Steps `sim` on an absolute steady_clock timeline (frame n is due at start + n / rate + pauses, so
+/// late frames do not delay later ones) until a limit is reached or `stop` is set, polling for
+/// selection requests about once a millisecond. Above 2 kHz the last stretch before each deadline
+/// is spent yielding instead of sleeping, because a sleeping thread wakes up tens of microseconds
+/// late. Ends with `sim.finish`.
+void stream(Simulator& sim, UdpLink& link, const StreamLimits& limits, const std::atomic<bool>& stop,
+            std::ostream& log);
+
+}  // namespace rsg::sim

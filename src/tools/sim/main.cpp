@@ -1,0 +1,229 @@
+// rsg_sim: a simulated Franka Panda streaming SEND_BUF frames (PROTOCOL.md) over UDP, with the
+// faults a gateway must survive. See `rsg_sim --help`; the logic lives in rsg_sim_core.
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <csignal>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rsg/sim/simulator.hpp"
+#include "rsg/sim/udp_stream.hpp"
+
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;
+constexpr int kExitUsage = 2;
+
+// Set from the signal handler: the only state shared with it.
+std::atomic<bool> g_stop{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
+
+void request_stop(int) { g_stop.store(true, std::memory_order_relaxed); }
+
+void install_stop_handlers() {
+  struct sigaction action {};
+  action.sa_handler = request_stop;
+  sigemptyset(&action.sa_mask);
+  for (const int signal : {SIGINT, SIGTERM}) sigaction(signal, &action, nullptr);
+}
+
+struct Options {
+  std::string to;
+  std::optional<std::uint64_t> count;
+  std::optional<double> duration_s;
+  std::vector<std::string> every;
+  std::optional<rsg::Selection> base_selection;  // from --groups and --fields
+  unsigned pause_ms = 0;
+  std::string report_path;
+  std::string record_path;
+};
+
+constexpr const char* kScheduleHelp = R"(
+Selection and schedule:
+  Without --groups, --fields or --every, every frame carries all 44 fields (2137 bytes, IP-fragmented
+  above a 1500-byte MTU). --groups and --fields select fields for every frame; --every adds a periodic
+  entry. Frame k (counted from 0, dropped frames included) carries the union of --groups, --fields and
+  every --every N:LIST whose N divides k. LIST is comma-separated field names of PROTOCOL.md, group
+  tokens g0..g5 and/or "all". Example:
+      --every 1:q,dq,time --every 100:g1      q, dq, time always; group 1 too in frames 0, 100, 200...
+  A frame that no entry covers is sent with no field (a valid header-only frame).
+  A valid selection request received on the sending socket replaces all of this from the next frame.
+
+Time:
+  `time` is whole milliseconds of robot time since (re)start, frame k being k/rate seconds in (plus
+  pauses). Above 1 kHz consecutive frames share a millisecond, so `time` repeats (non-decreasing
+  instead of strictly increasing); the packet number still changes every frame. The motion is
+  computed at the exact frame instant, not at the rounded millisecond.
+
+Faults:
+  A frame suffers at most one fault. --X-every N hits frames N-1, 2N-1, ... (drop, corrupt, duplicate,
+  reorder, in that priority); otherwise one random draw per frame picks a fault by the probabilities
+  (which must sum to <= 1). A corrupted frame is replaced by a datagram that a conformant decoder
+  rejects with exactly one category; successive corruptions cycle through --corrupt-categories
+  (default: all seven). A reordered frame is sent right after the next valid frame; a dropped frame
+  still uses its packet number.
+
+Report (--report FILE, and a summary on stderr):
+  {"sent","valid","dropped","duplicated","reordered",
+   "invalid":{"truncated","length_mismatch","bad_crc","bad_request","reserved_bits",
+              "selection_mismatch","bad_value"},
+   "restarts","pauses","selection_requests","invalid_requests","send_failures"}
+  sent = valid + all invalid (datagrams on the wire, a duplicate counted twice).)";
+
+bool parse_categories(const std::string& list, std::vector<rsg::ErrorCategory>& out, std::string& error) {
+  out.clear();
+  std::size_t begin = 0;
+  while (begin <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', begin), list.size());
+    const std::string name = list.substr(begin, comma - begin);
+    const auto category = rsg::parse_error_category(name);
+    if (!category || *category == rsg::ErrorCategory::kNone) {
+      error = "'" + name + "' is not an error category of PROTOCOL.md";
+      return false;
+    }
+    out.push_back(*category);
+    begin = comma + 1;
+  }
+  return true;
+}
+
+void add_options(CLI::App& app, Options& options, rsg::sim::SimConfig& config) {
+  app.add_option("--to", options.to, "Where to send frames, HOST:PORT")->required();
+  app.add_option("--rate", config.rate_hz, "Frames per second")
+      ->check(CLI::Range(1e-3, 1e6))
+      ->capture_default_str();
+  auto* count = app.add_option("--count", options.count, "Send this many frames, then exit");
+  app.add_option("--duration", options.duration_s, "Send for this many seconds, then exit")
+      ->check(CLI::PositiveNumber)
+      ->excludes(count);
+  app.add_option("--seed", config.seed, "Seed of the motion and of the random faults")->capture_default_str();
+
+  const auto selection_option = [&](const char* name, auto parse, const char* help) {
+    app.add_option_function<std::string>(
+        name,
+        [&options, parse, name](const std::string& list) {
+          rsg::Selection selection;
+          std::string error;
+          if (!parse(list, selection, error)) throw CLI::ValidationError(name, error);
+          options.base_selection =
+              rsg::sim::unite(options.base_selection.value_or(rsg::Selection{}), selection);
+        },
+        help);
+  };
+  selection_option("--groups", rsg::parse_group_list, "Comma-separated group numbers 0..5 for every frame");
+  selection_option("--fields", rsg::parse_field_list, "Comma-separated field names for every frame");
+  app.add_option("--every", options.every, "N:LIST, repeatable: LIST in frames whose index N divides");
+
+  auto* faults = app.add_option_group("Faults");
+  rsg::sim::FaultConfig& fault = config.faults;
+  const auto probability = [&](const char* name, double& value, const char* what) {
+    faults->add_option(name, value, std::string("Probability that a frame is ") + what)
+        ->check(CLI::Range(0.0, 1.0));
+  };
+  probability("--drop", fault.drop, "not sent");
+  probability("--duplicate", fault.duplicate, "sent twice");
+  probability("--reorder", fault.reorder, "sent after the next one");
+  probability("--corrupt", fault.corrupt, "replaced by an invalid datagram");
+  faults->add_option("--drop-every", fault.drop_every, "Drop frames N-1, 2N-1, ...");
+  faults->add_option("--duplicate-every", fault.duplicate_every, "Duplicate frames N-1, 2N-1, ...");
+  faults->add_option("--reorder-every", fault.reorder_every, "Reorder frames N-1, 2N-1, ...");
+  faults->add_option("--corrupt-every", fault.corrupt_every, "Corrupt frames N-1, 2N-1, ...");
+  faults->add_option_function<std::string>(
+      "--corrupt-categories",
+      [&fault](const std::string& list) {
+        std::string error;
+        if (!parse_categories(list, fault.corrupt_categories, error))
+          throw CLI::ValidationError("--corrupt-categories", error);
+      },
+      "Comma-separated categories that corruptions cycle through (default: all seven)");
+  auto* pause_after =
+      faults->add_option("--pause-after", config.pause_after,
+                         "After N frames, the link goes silent for --pause-ms (time runs on)");
+  faults->add_option("--pause-ms", options.pause_ms, "Length of the --pause-after silence, ms")
+      ->needs(pause_after);
+  faults->add_option("--restart-after", config.restart_after,
+                     "After N frames, the robot reboots: time and packet number restart from 0");
+
+  app.add_option("--report", options.report_path, "Write the JSON report of what was sent to FILE");
+  app.add_option("--record", options.record_path,
+                 "Write the canonical JSON of every valid datagram sent to FILE, one per line");
+}
+
+/// Turns the selection options into the schedule; throws CLI::ValidationError.
+rsg::sim::Schedule build_schedule(const Options& options) {
+  rsg::sim::Schedule schedule;
+  if (options.base_selection) schedule.add(1, *options.base_selection);
+  for (const std::string& entry : options.every) {
+    std::string error;
+    if (!schedule.add(entry, error)) throw CLI::ValidationError("--every", error);
+  }
+  if (schedule.empty()) schedule.add(1, rsg::Selection::all());
+  return schedule;
+}
+
+void check_probabilities(const rsg::sim::FaultConfig& faults) {
+  if (faults.drop + faults.duplicate + faults.reorder + faults.corrupt > 1.0)
+    throw CLI::ValidationError("--drop/--duplicate/--reorder/--corrupt",
+                               "probabilities add up to more than 1");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Simulated Franka Panda: streams SEND_BUF frames (PROTOCOL.md) over UDP.", "rsg_sim"};
+  app.footer(std::string(kScheduleHelp) +
+             "\n\nRuns until --count/--duration or SIGINT/SIGTERM. Exit status: 0 success, 1 runtime "
+             "error (socket, file), 2 usage error.");
+  Options options;
+  rsg::sim::SimConfig config;
+  add_options(app, options, config);
+  try {
+    app.parse(argc, argv);
+    config.schedule = build_schedule(options);
+    check_probabilities(config.faults);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+  config.pause = std::chrono::milliseconds(options.pause_ms);
+
+  try {
+    const rsg::Endpoint peer = rsg::Endpoint::parse(options.to);
+    rsg::UdpSocket socket = rsg::UdpSocket::for_sending_to(peer);
+    rsg::sim::UdpLink link(socket, peer);
+    rsg::sim::Simulator sim(config);
+
+    std::ofstream record;
+    if (!options.record_path.empty()) {
+      record.open(options.record_path);
+      if (!record) throw std::runtime_error("cannot write '" + options.record_path + "'");
+      sim.record_to(&record);
+    }
+
+    rsg::sim::StreamLimits limits;
+    limits.count = options.count;
+    if (options.duration_s)
+      limits.duration = std::chrono::duration_cast<std::chrono::nanoseconds>(
+          std::chrono::duration<double>(*options.duration_s));
+
+    install_stop_handlers();
+    std::cerr << "rsg_sim: sending to " << peer.to_string() << " at " << config.rate_hz << " Hz\n";
+    rsg::sim::stream(sim, link, limits, g_stop, std::cerr);
+
+    std::cerr << "rsg_sim: " << sim.report().summary() << "\n";
+    if (!options.report_path.empty()) {
+      std::ofstream report(options.report_path);
+      report << sim.report().to_json() << "\n";
+      if (!report) throw std::runtime_error("cannot write '" + options.report_path + "'");
+    }
+    if (record.is_open() && !record.flush())
+      throw std::runtime_error("cannot write '" + options.record_path + "'");
+  } catch (const std::exception& e) {
+    std::cerr << "rsg_sim: error: " << e.what() << "\n";
+    return kExitFailure;
+  }
+  return kExitOk;
+}

@@ -1,0 +1,89 @@
+#include "rsg/sim/schedule.hpp"
+
+#include <charconv>
+
+namespace rsg::sim {
+namespace {
+
+std::string_view trimmed(std::string_view text) {
+  while (!text.empty() && text.front() == ' ') text.remove_prefix(1);
+  while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
+  return text;
+}
+
+bool parse_item(std::string_view item, Selection& selection, std::string& error) {
+  if (item == "all") {
+    selection = unite(selection, Selection::all());
+    return true;
+  }
+  if (const auto field = find_field(item)) {
+    selection.add(*field);
+    return true;
+  }
+  // No field name starts with "g" followed by a digit, so group tokens cannot shadow a field.
+  unsigned group = 0;
+  if (item.size() >= 2 && item.front() == 'g') {
+    const auto [end, ec] = std::from_chars(item.data() + 1, item.data() + item.size(), group);
+    if (ec == std::errc{} && end == item.data() + item.size() && group < kGroupCount) {
+      selection.add_group(group);
+      return true;
+    }
+  }
+  error = "'" + std::string(item) + "' is neither a field name of PROTOCOL.md, a group g0..g5, nor all";
+  return false;
+}
+
+}  // namespace
+
+Selection unite(const Selection& a, const Selection& b) {
+  Selection both;
+  both.group_select = static_cast<std::uint8_t>(a.group_select | b.group_select);
+  for (std::size_t group = 0; group < kGroupCount; ++group)
+    both.data_select[group] = static_cast<std::uint8_t>(a.data_select[group] | b.data_select[group]);
+  return both;
+}
+
+bool parse_selection_items(std::string_view list, Selection& out, std::string& error) {
+  Selection selection;
+  while (true) {
+    const std::size_t comma = list.find(',');
+    const std::string_view item = trimmed(list.substr(0, comma));
+    if (item.empty()) {
+      error = "empty item in '" + std::string(list) + "'";
+      return false;
+    }
+    if (!parse_item(item, selection, error)) return false;
+    if (comma == std::string_view::npos) break;
+    list.remove_prefix(comma + 1);
+  }
+  out = selection;
+  return true;
+}
+
+bool Schedule::add(std::string_view spec, std::string& error) {
+  const std::size_t colon = spec.find(':');
+  if (colon == std::string_view::npos) {
+    error = "'" + std::string(spec) + "' is not N:LIST";
+    return false;
+  }
+  const std::string_view period_text = trimmed(spec.substr(0, colon));
+  std::uint64_t period = 0;
+  const auto [end, ec] = std::from_chars(period_text.data(), period_text.data() + period_text.size(), period);
+  if (ec != std::errc{} || end != period_text.data() + period_text.size() || period == 0) {
+    error = "'" + std::string(period_text) + "' in '" + std::string(spec) + "' is not a period N >= 1";
+    return false;
+  }
+  Selection selection;
+  if (!parse_selection_items(spec.substr(colon + 1), selection, error)) return false;
+  add(period, selection);
+  return true;
+}
+
+Selection Schedule::at(std::uint64_t frame) const {
+  Selection selection;
+  for (const Entry& entry : entries_)
+    if (frame % entry.period == 0) selection = unite(selection, entry.selection);
+  return selection;
+}
+
+}  // namespace rsg::sim

@@ -1,0 +1,78 @@
+#include "rsg/sim/udp_stream.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <thread>
+
+namespace rsg::sim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using std::chrono::nanoseconds;
+
+constexpr double kSpinAboveHz = 2000;
+constexpr nanoseconds kSpinWindow = std::chrono::microseconds(200);
+// Sleeps are cut into slices so that a stop request ends a long pause promptly.
+constexpr nanoseconds kLongestSleep = std::chrono::milliseconds(50);
+constexpr double kRequestPollsPerSecond = 1000;
+
+void wait_until(Clock::time_point deadline, nanoseconds spin_window, const std::atomic<bool>& stop) {
+  while (!stop.load(std::memory_order_relaxed)) {
+    const nanoseconds remaining = deadline - Clock::now();
+    if (remaining <= nanoseconds::zero()) return;
+    if (remaining > spin_window)
+      std::this_thread::sleep_for(std::min(remaining - spin_window, kLongestSleep));
+    else
+      std::this_thread::yield();
+  }
+}
+
+std::string describe(const Selection& selection) {
+  std::string fields;
+  for (const FieldInfo& field : kFields)
+    if (selection.contains(field.id())) fields += (fields.empty() ? "" : ",") + std::string(field.name);
+  return fields.empty() ? "no field" : fields;
+}
+
+}  // namespace
+
+void UdpLink::poll_requests(Simulator& sim, std::ostream& log) {
+  Endpoint from;
+  while (const auto size = socket_.receive(request_, &from, std::chrono::milliseconds(0))) {
+    const std::size_t kept = std::min(*size, request_.size());
+    const SelectionRequestResult request = sim.handle_request({request_.data(), kept});
+    if (request)
+      log << "rsg_sim: selection request from " << from.to_string() << ": now sending "
+          << describe(request.selection) << "\n";
+    else
+      log << "rsg_sim: ignored an invalid selection request from " << from.to_string() << " ("
+          << to_string(request.error.category()) << ": " << request.error.message() << ")\n";
+  }
+}
+
+void stream(Simulator& sim, UdpLink& link, const StreamLimits& limits, const std::atomic<bool>& stop,
+            std::ostream& log) {
+  const double rate = sim.config().rate_hz;
+  const nanoseconds spin_window = rate > kSpinAboveHz ? kSpinWindow : nanoseconds::zero();
+  const auto poll_every = static_cast<std::uint64_t>(std::max(1.0, rate / kRequestPollsPerSecond));
+  const Clock::time_point start = Clock::now();
+  nanoseconds paused{0};
+
+  for (std::uint64_t frame = 0; !limits.count || frame < *limits.count; ++frame) {
+    const nanoseconds due = nanoseconds(std::llround(static_cast<double>(frame) * 1e9 / rate)) + paused;
+    if (limits.duration && due >= *limits.duration) break;
+    wait_until(start + due, spin_window, stop);
+    if (stop.load(std::memory_order_relaxed)) break;
+    const std::uint64_t restarts = sim.report().restarts;
+    const nanoseconds pause = sim.step(link);
+    if (sim.report().restarts != restarts) log << "rsg_sim: robot restarted before frame " << frame << "\n";
+    if (pause > nanoseconds::zero())
+      log << "rsg_sim: link down for " << std::chrono::duration<double, std::milli>(pause).count()
+          << " ms after frame " << frame << "\n";
+    paused += pause;
+    if (frame % poll_every == 0) link.poll_requests(sim, log);
+  }
+  sim.finish(link);
+}
+
+}  // namespace rsg::sim
