@@ -1,0 +1,126 @@
+#include "rsg/views.hpp"
+
+#include <fastdds/rtps/attributes/PropertyPolicy.h>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+
+#include "rsg/field_table.hpp"
+#include "rsg/selection.hpp"
+
+namespace rsg {
+namespace {
+
+using eprosima::fastrtps::rtps::PropertyPolicyHelper;
+
+constexpr std::uint8_t kValidGroupBits = (1U << kGroupCount) - 1;
+
+void check_groups(std::uint8_t groups) {
+  if (groups == 0) throw ViewError("a view needs at least one group");
+  if ((groups & ~kValidGroupBits) != 0)
+    throw ViewError("group bits 6 and 7 are reserved: a view can only ask for groups 0..5");
+}
+
+// Reuses the participant's filtered topic of that name, so that several readers of one view
+// share it; a name already taken by something else is a configuration error, not a reuse.
+fdds::ContentFilteredTopic* find_or_create_filtered_topic(fdds::DomainParticipant& participant,
+                                                          fdds::Topic& topic, const std::string& name,
+                                                          const std::string& filter) {
+  fdds::TopicDescription* existing = participant.lookup_topicdescription(name);
+  if (existing == nullptr) {
+    fdds::ContentFilteredTopic* created = participant.create_contentfilteredtopic(name, &topic, filter, {});
+    if (created == nullptr)
+      throw std::runtime_error("cannot create the filtered topic '" + name + "' with filter \"" + filter +
+                               "\" (is the RobotState type object registered?)");
+    return created;
+  }
+  auto* filtered = dynamic_cast<fdds::ContentFilteredTopic*>(existing);
+  if (filtered == nullptr || filtered->get_related_topic() != &topic ||
+      filtered->get_filter_expression() != filter)
+    throw ViewError("the topic name '" + name +
+                    "' is already used with a different meaning in this participant");
+  return filtered;
+}
+
+}  // namespace
+
+std::string group_filter_expression(std::uint8_t groups) {
+  check_groups(groups);
+  std::string expression;
+  for (std::size_t group = 0; group < kGroupCount; ++group) {
+    if (((groups >> group) & 1U) == 0) continue;
+    if (!expression.empty()) expression += " AND ";
+    expression += "group_present[" + std::to_string(group) + "] = TRUE";
+  }
+  return expression;
+}
+
+View group_view(std::uint8_t groups) {
+  View view{.name = "groups", .groups = groups, .filter = group_filter_expression(groups)};
+  for (std::size_t group = 0; group < kGroupCount; ++group)
+    if ((groups >> group) & 1U) view.name += "_" + std::to_string(group);
+  return view;
+}
+
+View parse_view(const std::string& profile, const fdds::DataReaderQos& qos) {
+  const std::string* groups = PropertyPolicyHelper::find_property(qos.properties(), kViewGroupsProperty);
+  const std::string* filter = PropertyPolicyHelper::find_property(qos.properties(), kViewFilterProperty);
+  const std::string where = "profile '" + profile + "': ";
+  if (groups == nullptr && filter == nullptr)
+    throw ViewError(where + "not a view: it has no property " + kViewGroupsProperty + " or " +
+                    kViewFilterProperty);
+  if (groups != nullptr && filter != nullptr)
+    throw ViewError(where + "has both " + kViewGroupsProperty + " and " + kViewFilterProperty +
+                    "; a view is one or the other");
+  if (filter != nullptr) {
+    if (filter->empty()) throw ViewError(where + kViewFilterProperty + " is empty");
+    return View{.name = profile, .groups = 0, .filter = *filter};
+  }
+  std::uint8_t mask = 0;
+  std::string error;
+  if (!parse_group_mask(*groups, mask, error))
+    throw ViewError(where + kViewGroupsProperty + " = \"" + *groups + "\": " + error);
+  return View{.name = profile, .groups = mask, .filter = group_filter_expression(mask)};
+}
+
+fdds::DataReaderQos load_reader_qos(const fdds::Subscriber& subscriber, const std::string& profile) {
+  fdds::DataReaderQos qos;
+  if (subscriber.get_datareader_qos_from_profile(profile, qos) != ReturnCode_t::RETCODE_OK)
+    throw ViewError("profile '" + profile + "': no such data_reader profile (are the XML profiles loaded?)");
+  return qos;
+}
+
+View load_view(const fdds::Subscriber& subscriber, const std::string& profile) {
+  return parse_view(profile, load_reader_qos(subscriber, profile));
+}
+
+ViewReader::ViewReader(fdds::Subscriber& subscriber, fdds::Topic& topic, const std::string& view_profile,
+                       const std::string& qos_profile, fdds::DataReaderListener* listener,
+                       const fdds::StatusMask& mask)
+    : ViewReader(subscriber, topic, load_view(subscriber, view_profile),
+                 load_reader_qos(subscriber, qos_profile.empty() ? view_profile : qos_profile), listener,
+                 mask) {}
+
+ViewReader::ViewReader(fdds::Subscriber& subscriber, fdds::Topic& topic, View view,
+                       const fdds::DataReaderQos& qos, fdds::DataReaderListener* listener,
+                       const fdds::StatusMask& mask)
+    : subscriber_(subscriber), view_(std::move(view)) {
+  fdds::DomainParticipant& participant = *topic.get_participant();
+  if (subscriber.get_participant() != &participant)
+    throw std::invalid_argument("ViewReader: subscriber and topic belong to different participants");
+  const std::string name = topic.get_name() + "/" + view_.name;
+  filtered_topic_ = find_or_create_filtered_topic(participant, topic, name, view_.filter);
+  reader_ = subscriber.create_datareader(filtered_topic_, qos, listener, mask);
+  if (reader_ == nullptr) {
+    participant.delete_contentfilteredtopic(filtered_topic_);  // refused while another reader uses it
+    throw std::runtime_error("cannot create a reader on '" + name + "' (inconsistent reader QoS?)");
+  }
+}
+
+ViewReader::~ViewReader() {
+  subscriber_.delete_datareader(reader_);
+  // Fast DDS refuses (PRECONDITION_NOT_MET) while another reader still uses the filtered topic;
+  // the last ViewReader on the view deletes it.
+  filtered_topic_->get_participant()->delete_contentfilteredtopic(filtered_topic_);
+}
+
+}  // namespace rsg
