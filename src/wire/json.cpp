@@ -215,7 +215,7 @@ bool parse_canonical_json(std::string_view text, StateValues& out, std::string& 
   Json root;
   try {
     root = Json::parse(text);
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {  // parse_error, and out_of_range for numbers beyond double
     error = std::string("malformed JSON: ") + e.what();
     return false;
   }

@@ -167,6 +167,13 @@ class Encode(unittest.TestCase):
         self.assertEqual(len(out.decode().splitlines()), 1)  # the line before the error was written
         self.assertTrue(err.startswith("error: line 3: malformed JSON"), err)
 
+    def test_number_beyond_double_range_is_malformed_json(self):
+        # Found by fuzz_json: the JSON library reports it as out_of_range, not as a parse error.
+        text = '{"packet_number":0,"group_select":32,"data_select":[0,0,0,0,0,2],"fields":{"control_command_success_rate":1e999}}'
+        status, out, err = run("encode", stdin=text.encode())
+        self.assertEqual((status, out), (1, b""))
+        self.assertTrue(err.startswith("error: line 1: malformed JSON: "), err)
+
     def test_object_that_does_not_describe_a_frame(self):
         cases = {
             '{"packet_number":0,"group_select":4,"data_select":[0,0,32,0,0,0],"fields":{"qq":[]}}':

@@ -1,0 +1,39 @@
+// decode() on arbitrary bytes. A frame it accepts must be exactly what encode() writes for the
+// values it carries, and the deframer must find it as one frame.
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include "fuzz_check.hpp"
+#include "rsg/deframer.hpp"
+#include "rsg/frame.hpp"
+#include "rsg/state_values.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::span<const std::uint8_t> bytes(data, size);
+  const rsg::DecodeResult result = rsg::decode(bytes);
+  if (!result) {
+    FUZZ_REQUIRE(result.error().category() != rsg::ErrorCategory::kNone);
+    FUZZ_REQUIRE(!result.error().message().empty());
+    return 0;
+  }
+
+  rsg::StateValues values;
+  values.assign(result.frame());
+  std::array<std::uint8_t, rsg::kMaxFrameBytes> encoded{};
+  const rsg::EncodeResult reencoded = rsg::encode(values.packet_number, values.selection, values.storage(),
+                                                  rsg::StateValues::layout(), encoded);
+  FUZZ_REQUIRE(reencoded);
+  FUZZ_REQUIRE(reencoded.size == bytes.size());
+  FUZZ_REQUIRE(std::equal(bytes.begin(), bytes.end(), encoded.begin()));
+
+  rsg::Deframer deframer;
+  std::size_t frames = 0;
+  deframer.feed(bytes, [&](std::span<const std::uint8_t> frame) {
+    FUZZ_REQUIRE(std::ranges::equal(frame, bytes));
+    ++frames;
+  });
+  FUZZ_REQUIRE(frames == 1 && deframer.skipped_bytes() == 0 && deframer.pending_bytes() == 0);
+  return 0;
+}
