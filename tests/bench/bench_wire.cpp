@@ -1,0 +1,178 @@
+// Wire codec costs against the floor every receiver pays: touching the bytes (memcpy) and checking
+// the CRC. Names are BM_<operation>_<frame>; run_bench.sh reports each one as a ratio to
+// BM_Crc32Isal_<frame>, the CRC alone on the same frame.
+//
+//   Full    every field: 2137 bytes, the frame the gateway normally receives
+//   Joints  q, dq, tau_J and time: 192 bytes, a typical small selection
+#include <benchmark/benchmark.h>
+#include <zlib.h>
+
+#include <array>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <span>
+#include <vector>
+
+#include "rsg/crc32.hpp"
+#include "rsg/deframer.hpp"
+#include "rsg/error_flags.hpp"
+#include "rsg/frame.hpp"
+#include "rsg/state_values.hpp"
+
+namespace {
+
+/// A valid frame carrying `selection`, and the values it was encoded from.
+class SampleFrame {
+ public:
+  explicit SampleFrame(const rsg::Selection& selection) {
+    values_.packet_number = 5;
+    values_.selection = selection;
+    for (const rsg::FieldInfo& field : rsg::kFields) fill(field);
+    bytes_.resize(rsg::kMaxFrameBytes);
+    const rsg::EncodeResult result =
+        rsg::encode(values_.packet_number, selection, values_.storage(), rsg::StateValues::layout(), bytes_);
+    if (!result) std::abort();  // a benchmark of a frame that does not encode would measure nothing
+    bytes_.resize(result.size);
+  }
+
+  const rsg::StateValues& values() const { return values_; }
+  std::span<const std::uint8_t> bytes() const { return bytes_; }
+  /// The bytes the trailer's CRC covers: header and data.
+  std::span<const std::uint8_t> crc_covered() const { return bytes().first(bytes_.size() - rsg::kCrcBytes); }
+
+ private:
+  void fill(const rsg::FieldInfo& field) {
+    switch (field.type) {
+      case rsg::ElementType::kFloat64: {
+        double element = field.index;
+        for (double& value : values_.doubles(field.id())) value = element += 0.125;
+        break;
+      }
+      case rsg::ElementType::kErrorSet:
+        values_.set_integer(field.id(), 0x15'5555'5555ULL >> field.index % 2);  // every other flag
+        break;
+      case rsg::ElementType::kUInt8:
+        values_.set_integer(field.id(), rsg::kMaxRobotMode);
+        break;
+      case rsg::ElementType::kUInt64:
+        values_.set_integer(field.id(), 1'234'567'890'123ULL);
+        break;
+    }
+  }
+
+  rsg::StateValues values_;
+  std::vector<std::uint8_t> bytes_;
+};
+
+rsg::Selection joints_selection() {
+  rsg::Selection selection;
+  for (const rsg::Field field : {rsg::Field::tau_J, rsg::Field::q, rsg::Field::dq, rsg::Field::time})
+    selection.add(field);
+  return selection;
+}
+
+const SampleFrame& full_frame() {
+  static const SampleFrame frame(rsg::Selection::all());
+  return frame;
+}
+
+const SampleFrame& joints_frame() {
+  static const SampleFrame frame(joints_selection());
+  return frame;
+}
+
+void count_bytes(benchmark::State& state, std::size_t bytes_per_iteration) {
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * bytes_per_iteration));
+}
+
+void BM_Memcpy(benchmark::State& state, const SampleFrame& frame) {
+  std::array<std::uint8_t, rsg::kMaxFrameBytes> copy{};
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(frame.bytes().data());
+    std::memcpy(copy.data(), frame.bytes().data(), frame.bytes().size());
+    benchmark::ClobberMemory();
+  }
+  count_bytes(state, frame.bytes().size());
+}
+
+void BM_Crc32Isal(benchmark::State& state, const SampleFrame& frame) {
+  for (auto _ : state) benchmark::DoNotOptimize(rsg::crc32(frame.crc_covered()));
+  count_bytes(state, frame.crc_covered().size());
+}
+
+void BM_Crc32Zlib(benchmark::State& state, const SampleFrame& frame) {
+  const auto covered = frame.crc_covered();
+  for (auto _ : state)
+    benchmark::DoNotOptimize(::crc32(0, covered.data(), static_cast<uInt>(covered.size())));
+  count_bytes(state, covered.size());
+}
+
+/// Validation alone: what a receiver that only counts frames pays.
+void BM_DecodeValidateOnly(benchmark::State& state, const SampleFrame& frame) {
+  for (auto _ : state) {
+    const rsg::DecodeResult result = rsg::decode(frame.bytes());
+    benchmark::DoNotOptimize(&result);
+  }
+  count_bytes(state, frame.bytes().size());
+}
+
+/// What the gateway does per datagram: validate, then copy every field into the sample.
+void BM_Decode(benchmark::State& state, const SampleFrame& frame) {
+  rsg::StateValues values;
+  for (auto _ : state) {
+    const rsg::DecodeResult result = rsg::decode(frame.bytes());
+    if (!result) {
+      state.SkipWithError("the sample frame does not decode");
+      break;
+    }
+    values.assign(result.frame());
+    benchmark::DoNotOptimize(values.storage());
+    benchmark::ClobberMemory();
+  }
+  count_bytes(state, frame.bytes().size());
+}
+
+void BM_Encode(benchmark::State& state, const SampleFrame& frame) {
+  const rsg::StateValues& values = frame.values();
+  std::array<std::uint8_t, rsg::kMaxFrameBytes> out{};
+  for (auto _ : state) {
+    const rsg::EncodeResult result = rsg::encode(values.packet_number, values.selection, values.storage(),
+                                                 rsg::StateValues::layout(), out);
+    benchmark::DoNotOptimize(&result);
+    benchmark::ClobberMemory();
+  }
+  count_bytes(state, frame.bytes().size());
+}
+
+/// A stream of back-to-back frames arriving in 1472-byte pieces (a UDP payload on a 1500-byte MTU),
+/// so frames straddle reads. One iteration delivers one frame's worth of bytes and yields one frame.
+void BM_Deframer(benchmark::State& state, const SampleFrame& frame) {
+  constexpr std::size_t kReadBytes = 1472;
+  rsg::Deframer deframer;
+  benchmark::IterationCount frames = 0;
+  const auto count = [&frames](std::span<const std::uint8_t>) { ++frames; };
+  for (auto _ : state) {
+    for (std::size_t offset = 0; offset < frame.bytes().size(); offset += kReadBytes)
+      deframer.feed(frame.bytes().subspan(offset, std::min(kReadBytes, frame.bytes().size() - offset)),
+                    count);
+  }
+  if (frames != state.iterations()) state.SkipWithError("the deframer lost frames");
+  count_bytes(state, frame.bytes().size());
+}
+
+}  // namespace
+
+BENCHMARK_CAPTURE(BM_Memcpy, Full, full_frame())->Name("BM_Memcpy_Full");
+BENCHMARK_CAPTURE(BM_Crc32Isal, Full, full_frame())->Name("BM_Crc32Isal_Full");
+BENCHMARK_CAPTURE(BM_Crc32Zlib, Full, full_frame())->Name("BM_Crc32Zlib_Full");
+BENCHMARK_CAPTURE(BM_DecodeValidateOnly, Full, full_frame())->Name("BM_DecodeValidateOnly_Full");
+BENCHMARK_CAPTURE(BM_Decode, Full, full_frame())->Name("BM_Decode_Full");
+BENCHMARK_CAPTURE(BM_Encode, Full, full_frame())->Name("BM_Encode_Full");
+BENCHMARK_CAPTURE(BM_Deframer, Full, full_frame())->Name("BM_Deframer_Full");
+
+BENCHMARK_CAPTURE(BM_Crc32Isal, Joints, joints_frame())->Name("BM_Crc32Isal_Joints");
+BENCHMARK_CAPTURE(BM_Decode, Joints, joints_frame())->Name("BM_Decode_Joints");
+BENCHMARK_CAPTURE(BM_Encode, Joints, joints_frame())->Name("BM_Encode_Joints");
+
+BENCHMARK_MAIN();
