@@ -1,0 +1,96 @@
+#include "egress.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <fastdds/dds/core/LoanableSequence.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <stdexcept>
+
+#include "rsg/robot_state.hpp"
+
+namespace rsg::gateway {
+namespace {
+
+// How long the thread sleeps without samples before it looks at its log again.
+const eprosima::fastrtps::Duration_t kIdleWake{1, 0};
+
+}  // namespace
+
+Egress::Egress(Participant& participant, const Options& options) : participant_(participant) {
+  for (const Endpoint& endpoint : options.destinations)
+    destinations_.push_back({endpoint, UdpSocket::for_sending_to(endpoint)});
+
+  subscriber_ = participant_.subscriber(options.partitions);
+  fdds::Topic* topic = participant_.robot_state_topic(options.topic);
+  reader_ = subscriber_->create_datareader_with_profile(topic, options.reader_profile);
+  if (!reader_) {
+    participant_.get()->delete_subscriber(subscriber_);
+    throw std::runtime_error("cannot create the RobotState reader with profile '" + options.reader_profile +
+                             "'");
+  }
+  reader_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
+  waitset_.attach_condition(reader_->get_statuscondition());
+  waitset_.attach_condition(stop_);
+  thread_ = std::thread([this] { run(); });
+}
+
+Egress::~Egress() {
+  stop_.set_trigger_value(true);
+  thread_.join();
+  waitset_.detach_condition(stop_);
+  waitset_.detach_condition(reader_->get_statuscondition());
+  subscriber_->delete_datareader(reader_);
+  participant_.get()->delete_subscriber(subscriber_);
+}
+
+EgressCounters Egress::counters() const {
+  return {samples_.load(std::memory_order_relaxed), frames_sent_.load(std::memory_order_relaxed),
+          unencodable_.load(std::memory_order_relaxed), send_failed_.load(std::memory_order_relaxed)};
+}
+
+void Egress::run() {
+  fdds::ConditionSeq triggered;
+  while (!stop_.get_trigger_value()) {
+    waitset_.wait(triggered, kIdleWake);
+    forward_available();
+    log_unencodable();
+  }
+}
+
+void Egress::forward_available() {
+  FASTDDS_SEQUENCE(RobotStateSeq, RobotState);
+  RobotStateSeq samples;
+  fdds::SampleInfoSeq infos;
+  while (reader_->take(samples, infos) == ReturnCode_t::RETCODE_OK) {
+    for (fdds::LoanableCollection::size_type i = 0; i < samples.length(); ++i)
+      if (infos[i].valid_data) forward(samples[i]);
+    reader_->return_loan(samples, infos);
+  }
+}
+
+void Egress::forward(const RobotState& sample) {
+  samples_.fetch_add(1, std::memory_order_relaxed);
+  const EncodeResult encoded = to_frame(sample, frame_);
+  if (!encoded) {
+    unencodable_.fetch_add(1, std::memory_order_relaxed);
+    last_encode_error_ = encoded.error;
+    return;
+  }
+  for (Destination& destination : destinations_) {
+    if (destination.socket.send_to(std::span(frame_).first(encoded.size), destination.endpoint))
+      frames_sent_.fetch_add(1, std::memory_order_relaxed);
+    else
+      send_failed_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+void Egress::log_unencodable() {
+  const std::uint64_t total = unencodable_.load(std::memory_order_relaxed);
+  if (total == logged_unencodable_ || !unencodable_log_.allow(Clock::now())) return;
+  spdlog::warn("{} samples of the egress topic describe no valid frame and were not sent; the last: {}: {}",
+               total - logged_unencodable_, to_string(last_encode_error_.category()),
+               last_encode_error_.message());
+  logged_unencodable_ = total;
+}
+
+}  // namespace rsg::gateway

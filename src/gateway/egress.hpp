@@ -1,0 +1,82 @@
+// Egress: RobotState samples -> raw frames sent to one or more UDP destinations.
+//
+// Runs its own thread, woken by a WaitSet when samples arrive, so a slow DDS side never stalls
+// ingress. Samples are taken as loans (zero-copy with data-sharing) and encoded into one buffer
+// allocated at start-up. A frame that went raw -> DDS -> raw comes out byte-identical, because
+// the sample keeps the packet number and the selection and `to_frame` rewrites exactly that.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <fastdds/dds/core/condition/GuardCondition.hpp>
+#include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rsg/frame.hpp"
+#include "rsg/gateway/log_throttle.hpp"
+#include "rsg/gateway/stats.hpp"
+#include "rsg/participant.hpp"
+#include "rsg/udp_socket.hpp"
+
+namespace rsg {
+class RobotState;
+}
+
+namespace rsg::gateway {
+
+class Egress {
+ public:
+  struct Options {
+    std::string topic;
+    std::vector<std::string> partitions;
+    std::string reader_profile;
+    std::vector<Endpoint> destinations;
+  };
+
+  /// Creates the reader and the sockets, then starts the thread. Throws std::runtime_error.
+  Egress(Participant& participant, const Options& options);
+  /// Stops the thread, then deletes the reader.
+  ~Egress();
+  Egress(const Egress&) = delete;
+  Egress& operator=(const Egress&) = delete;
+
+  /// The counters so far; safe from any thread.
+  EgressCounters counters() const;
+
+ private:
+  struct Destination {
+    Endpoint endpoint;
+    UdpSocket socket;
+  };
+
+  void run();
+  void forward_available();
+  void forward(const RobotState& sample);
+  void log_unencodable();
+
+  Participant& participant_;
+  fdds::Subscriber* subscriber_ = nullptr;
+  fdds::DataReader* reader_ = nullptr;
+  std::vector<Destination> destinations_;
+  std::array<std::uint8_t, kMaxFrameBytes> frame_{};
+
+  fdds::WaitSet waitset_;
+  fdds::GuardCondition stop_;
+
+  // Written by the egress thread only, read by the status loop.
+  std::atomic<std::uint64_t> samples_{0};
+  std::atomic<std::uint64_t> frames_sent_{0};
+  std::atomic<std::uint64_t> unencodable_{0};
+  std::atomic<std::uint64_t> send_failed_{0};
+  // Egress thread only: the rate-limited log of samples that are no valid frame.
+  FrameError last_encode_error_;
+  std::uint64_t logged_unencodable_ = 0;
+  LogThrottle unencodable_log_{std::chrono::seconds(1)};
+
+  std::thread thread_;  // last: starts once everything it uses exists
+};
+
+}  // namespace rsg::gateway

@@ -1,0 +1,196 @@
+#include "gateway.hpp"
+
+#include <fastrtps/attributes/ParticipantAttributes.h>
+#include <fastrtps/attributes/PublisherAttributes.h>
+#include <fastrtps/attributes/SubscriberAttributes.h>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <thread>
+
+#include "rsg/profiles.hpp"
+
+namespace rsg::gateway {
+namespace {
+
+using std::chrono::milliseconds;
+using XMLProfiles = eprosima::fastrtps::xmlparser::XMLProfileManager;
+using eprosima::fastrtps::xmlparser::XMLP_ret;
+
+constexpr auto kStatusPeriod = std::chrono::seconds(1);
+constexpr auto kSummaryPeriod = std::chrono::seconds(10);
+// The longest the loop sleeps: bounds how late it notices a stop request or a due status.
+constexpr milliseconds kLongestWait{100};
+
+Endpoint resolve(const std::string& flag, const std::string& host_port) {
+  try {
+    return Endpoint::parse(host_port);
+  } catch (const std::invalid_argument& error) {
+    throw std::runtime_error("--" + flag + ": " + error.what());
+  }
+}
+
+void load_and_check_profiles(const GatewayConfig& config) {
+  const std::filesystem::path profiles =
+      config.profiles.empty() ? default_profiles_dir() : std::filesystem::path(config.profiles);
+  load_profiles(profiles);
+
+  // Fast DDS only notices a missing profile when an entity is created from it; look first.
+  eprosima::fastrtps::ParticipantAttributes participant;
+  eprosima::fastrtps::PublisherAttributes writer;
+  eprosima::fastrtps::SubscriberAttributes reader;
+  const auto require = [&](bool found, const std::string& kind, const std::string& name) {
+    if (!found)
+      throw std::runtime_error(profiles.string() + ": no " + kind + " profile named '" + name + "'");
+  };
+  require(XMLProfiles::fillParticipantAttributes(config.participant_profile, participant, false) ==
+              XMLP_ret::XML_OK,
+          "participant", config.participant_profile);
+  require(XMLProfiles::fillPublisherAttributes(config.status_profile, writer, false) == XMLP_ret::XML_OK,
+          "data_writer", config.status_profile);
+  if (config.has_ingress())
+    require(XMLProfiles::fillPublisherAttributes(config.writer_profile, writer, false) == XMLP_ret::XML_OK,
+            "data_writer", config.writer_profile);
+  if (config.has_egress())
+    require(XMLProfiles::fillSubscriberAttributes(config.reader_profile, reader, false) == XMLP_ret::XML_OK,
+            "data_reader", config.reader_profile);
+}
+
+std::vector<std::string> partitions_of(const GatewayConfig& config) {
+  return config.partition.empty() ? std::vector<std::string>{} : std::vector<std::string>{config.partition};
+}
+
+}  // namespace
+
+GatewaySetup prepare(const GatewayConfig& config) {
+  if (auto problem = check_config(config)) throw std::runtime_error(*problem);
+
+  GatewaySetup setup{config, std::nullopt, std::nullopt};
+  if (config.has_ingress()) {
+    Ingress::Options ingress;
+    ingress.listen = resolve("listen", config.listen);
+    ingress.receive_buffer = config.receive_buffer;
+    for (const auto& network : config.allow_from) {
+      std::string error;
+      if (!ingress.sources.allow(network, error)) throw std::runtime_error("--allow-from: " + error);
+    }
+    ingress.topic = config.topic;
+    ingress.partitions = partitions_of(config);
+    ingress.writer_profile = config.writer_profile;
+    ingress.nominal_period = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(1.0 / config.expected_rate));
+    ingress.restart_threshold_ms = static_cast<std::uint64_t>(config.restart_threshold_ms);
+    if (config.requests_selection()) ingress.requested_selection = requested_selection(config);
+    if (!config.robot.empty()) ingress.robot = resolve("robot", config.robot);
+    setup.ingress = std::move(ingress);
+  }
+  if (config.has_egress()) {
+    Egress::Options egress;
+    egress.topic = config.egress_topic;
+    egress.partitions = partitions_of(config);
+    egress.reader_profile = config.reader_profile;
+    for (const auto& destination : config.send_to)
+      egress.destinations.push_back(resolve("send-to", destination));
+    setup.egress = std::move(egress);
+  }
+  load_and_check_profiles(config);
+  return setup;
+}
+
+Gateway::Gateway(const GatewaySetup& setup)
+    : config_(setup.config),
+      participant_(config_.domain, config_.participant_profile),
+      status_(participant_, config_.status_topic, partitions_of(config_), config_.status_profile) {
+  if (setup.ingress) {
+    ingress_.emplace(participant_, *setup.ingress);
+    spdlog::info("ingress: frames on UDP {} -> topic '{}' (domain {})",
+                 ingress_->local_endpoint().to_string(), config_.topic, config_.domain);
+  }
+  if (setup.egress) {
+    egress_.emplace(participant_, *setup.egress);
+    spdlog::info("egress: topic '{}' -> UDP {}", config_.egress_topic, fmt::join(config_.send_to, ", "));
+  }
+}
+
+void Gateway::run(const std::atomic<bool>& stop) {
+  auto now = Clock::now();
+  if (ingress_) ingress_->start(now);
+  rate_.update(0, now);
+  publish_status(snapshot());
+  auto next_status = now + kStatusPeriod;
+  auto next_summary = now + kSummaryPeriod;
+
+  while (!stop.load(std::memory_order_relaxed)) {
+    const auto wake = ingress_ ? std::min(next_status, ingress_->link_deadline()) : next_status;
+    const auto wait =
+        std::clamp(std::chrono::ceil<milliseconds>(wake - Clock::now()), milliseconds(0), kLongestWait);
+    if (ingress_)
+      ingress_->receive_one(wait);
+    else
+      std::this_thread::sleep_for(wait);
+
+    now = Clock::now();
+    if (ingress_ && ingress_->link_changed(now)) {
+      const GatewayStats stats = snapshot();
+      spdlog::info("link {} ({})", stats.link_up ? "up" : "down", stats.source);
+      publish_status(stats);
+    }
+    if (now < next_status) continue;
+
+    next_status += kStatusPeriod;
+    if (next_status < now) next_status = now + kStatusPeriod;  // after a stall, do not catch up
+    if (ingress_) {
+      GatewayStats counted;
+      ingress_->fill(counted);
+      rate_hz_ = rate_.update(counted.ingress.published + counted.ingress.publish_failed, now);
+      ingress_->log_rejections();
+    }
+    const GatewayStats stats = snapshot();
+    publish_status(stats);
+    write_stats_file(stats);
+    if (now >= next_summary) {
+      next_summary = now + kSummaryPeriod;
+      spdlog::info("{}", summary_line(stats));
+    }
+  }
+
+  const GatewayStats final_stats = snapshot();
+  publish_status(final_stats);
+  write_stats_file(final_stats);
+  spdlog::info("stopping: {}", summary_line(final_stats));
+}
+
+GatewayStats Gateway::snapshot() const {
+  GatewayStats stats;
+  if (ingress_) ingress_->fill(stats);
+  if (egress_) stats.egress = egress_->counters();
+  stats.rate_hz = stats.link_up ? rate_hz_ : 0.0;
+  return stats;
+}
+
+void Gateway::publish_status(const GatewayStats& stats) { status_.publish(stats); }
+
+void Gateway::write_stats_file(const GatewayStats& stats) const {
+  if (config_.stats_file.empty()) return;
+  // Written aside and renamed, so that a reader never sees half a file.
+  const std::filesystem::path target = config_.stats_file;
+  std::filesystem::path partial = target;
+  partial += ".partial";
+  {
+    std::ofstream out(partial, std::ios::trunc);
+    out << to_json(stats) << '\n';
+    if (!out) {
+      spdlog::warn("cannot write {}", partial.string());
+      return;
+    }
+  }
+  std::error_code error;
+  std::filesystem::rename(partial, target, error);
+  if (error) spdlog::warn("cannot write {}: {}", target.string(), error.message());
+}
+
+}  // namespace rsg::gateway

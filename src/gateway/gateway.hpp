@@ -1,0 +1,52 @@
+// The gateway process: one participant and, as configured, ingress, egress and status.
+//
+// Start-up is split so that nothing half-starts: `prepare()` resolves addresses, loads the XML
+// profiles and checks that every named profile exists -- all before any socket or DDS entity
+// exists -- and only then does `Gateway` create them.
+#pragma once
+
+#include <atomic>
+#include <optional>
+
+#include "egress.hpp"
+#include "ingress.hpp"
+#include "rsg/gateway/config.hpp"
+#include "rsg/gateway/link_monitor.hpp"
+#include "status_publisher.hpp"
+
+namespace rsg::gateway {
+
+/// A checked configuration with its addresses resolved.
+struct GatewaySetup {
+  GatewayConfig config;
+  std::optional<Ingress::Options> ingress;
+  std::optional<Egress::Options> egress;
+};
+
+/// Resolves and checks everything that can be checked without creating entities. Throws
+/// std::runtime_error with a message naming the flag, file or profile at fault.
+GatewaySetup prepare(const GatewayConfig& config);
+
+class Gateway {
+ public:
+  /// Binds, creates the DDS entities and starts egress. Throws std::runtime_error / std::system_error.
+  explicit Gateway(const GatewaySetup& setup);
+
+  /// Receives, publishes and reports until `stop` is set, then writes the final status.
+  void run(const std::atomic<bool>& stop);
+
+ private:
+  GatewayStats snapshot() const;
+  void publish_status(const GatewayStats& stats);
+  void write_stats_file(const GatewayStats& stats) const;
+
+  GatewayConfig config_;
+  Participant participant_;  // first: outlives every entity below
+  StatusPublisher status_;
+  std::optional<Ingress> ingress_;
+  std::optional<Egress> egress_;
+  RateMeter rate_;
+  double rate_hz_ = 0;
+};
+
+}  // namespace rsg::gateway

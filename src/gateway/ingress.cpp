@@ -1,0 +1,159 @@
+#include "ingress.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <stdexcept>
+
+namespace rsg::gateway {
+namespace {
+
+constexpr std::size_t kLargestDatagram = 65536;  // UDP payloads end at 65507 (IPv4) / 65527 (IPv6)
+
+std::optional<std::uint64_t> frame_time(const FrameView& frame) {
+  const auto bytes = frame.field_bytes(Field::time);
+  if (bytes.empty()) return std::nullopt;
+  std::uint64_t value = 0;
+  for (std::size_t i = 0; i < bytes.size(); ++i)
+    value |= std::uint64_t{bytes[i]} << (8 * i);  // little-endian
+  return value;
+}
+
+}  // namespace
+
+Ingress::Ingress(Participant& participant, Options options)
+    : options_(std::move(options)),
+      socket_(UdpSocket::bind(options_.listen)),
+      participant_(participant),
+      datagram_(kLargestDatagram),
+      sequence_(options_.restart_threshold_ms),
+      link_(options_.nominal_period) {
+  if (options_.receive_buffer > 0) {
+    const int granted = socket_.set_receive_buffer(options_.receive_buffer);
+    if (granted < options_.receive_buffer)
+      spdlog::warn("UDP receive buffer is {} bytes, not the {} asked for (raise net.core.rmem_max)", granted,
+                   options_.receive_buffer);
+  }
+  if (options_.requested_selection) requester_.emplace(*options_.requested_selection);
+
+  publisher_ = participant_.publisher(options_.partitions);
+  fdds::Topic* topic = participant_.robot_state_topic(options_.topic);
+  writer_ = publisher_->create_datawriter_with_profile(topic, options_.writer_profile);
+  if (!writer_) {
+    participant_.get()->delete_publisher(publisher_);
+    throw std::runtime_error("cannot create the RobotState writer with profile '" + options_.writer_profile +
+                             "'");
+  }
+  // Loans need a plain type; RobotState is one, but a profile could still make writes non-loanable.
+  writer_loans_ = writer_->get_type()->is_plain();
+}
+
+Ingress::~Ingress() {
+  publisher_->delete_datawriter(writer_);
+  participant_.get()->delete_publisher(publisher_);
+}
+
+void Ingress::start(Clock::time_point now) {
+  if (requester_ && options_.robot && requester_->start_up_due(now)) request_selection(*options_.robot, now);
+}
+
+void Ingress::receive_one(std::chrono::milliseconds timeout) {
+  if (const auto size = socket_.receive(datagram_, &sender_, timeout)) handle(*size, Clock::now());
+}
+
+void Ingress::handle(std::size_t size, Clock::time_point now) {
+  if (!options_.sources.allows(sender_.address())) {
+    ++counters_.rejected_source;
+    last_foreign_sender_ = sender_;
+    return;
+  }
+  ++counters_.received;
+
+  const DecodeResult decoded = decode(std::span(datagram_).first(std::min(size, datagram_.size())));
+  if (!decoded) {
+    ++counters_.invalid[invalid_index(decoded.error().category())];
+    last_rejection_ = decoded.error();
+    last_rejected_sender_ = sender_;
+    return;
+  }
+  const FrameView& frame = decoded.frame();
+
+  sequence_.observe(frame.packet_number(), frame_time(frame));
+  link_came_up_ |= link_.on_frame(now);
+  source_ = sender_;
+  if (requester_ && requester_->due(frame.selection(), now))
+    request_selection(options_.robot ? *options_.robot : sender_, now);
+
+  publish(frame);
+}
+
+void Ingress::publish(const FrameView& frame) {
+  void* loan = nullptr;
+  if (writer_loans_ &&
+      writer_->loan_sample(loan, fdds::DataWriter::LoanInitializationKind::CONSTRUCTED_LOAN_INITIALIZATION) ==
+          ReturnCode_t::RETCODE_OK) {
+    to_sample(frame, *static_cast<RobotState*>(loan));
+    if (writer_->write(loan)) {
+      ++counters_.published;
+    } else {
+      writer_->discard_loan(loan);
+      ++counters_.publish_failed;
+    }
+    return;
+  }
+  // No loan (type not plain, or every loanable slot still in use): the preallocated sample.
+  to_sample(frame, fallback_sample_);
+  if (writer_->write(&fallback_sample_))
+    ++counters_.published;
+  else
+    ++counters_.publish_failed;
+}
+
+void Ingress::request_selection(const Endpoint& robot, Clock::time_point) {
+  std::array<std::uint8_t, kSelectionRequestBytes> request{};
+  const EncodeResult encoded =
+      encode_selection_request(request_packet_number_, requester_->wanted(), request);
+  request_packet_number_ = static_cast<std::uint8_t>((request_packet_number_ + 1) % kPacketNumberModulo);
+  // From the listening socket, so that the robot's answer (its stream) comes back to it. Rare (at
+  // most once a second), so it may log.
+  if (encoded && socket_.send_to(std::span(request).first(encoded.size), robot))
+    spdlog::info("asked {} for selection group_select=0x{:02x}", robot.to_string(),
+                 requester_->wanted().group_select);
+  else
+    spdlog::warn("could not send the selection request to {}", robot.to_string());
+}
+
+bool Ingress::link_changed(Clock::time_point now) {
+  const bool came_up = std::exchange(link_came_up_, false);
+  const bool went_down = link_.poll(now);
+  return came_up || went_down;
+}
+
+void Ingress::fill(GatewayStats& stats) const {
+  stats.ingress = counters_;
+  stats.sequence = sequence_.counts();
+  stats.link_up = link_.up();
+  stats.source = source_.size() ? source_.to_string() : std::string();
+}
+
+void Ingress::log_rejections() {
+  const std::uint64_t rejected_source = counters_.rejected_source - logged_rejected_source_;
+  if (rejected_source)
+    spdlog::warn("ignored {} datagrams from outside --allow-from, the last from {}", rejected_source,
+                 last_foreign_sender_.to_string());
+  logged_rejected_source_ = counters_.rejected_source;
+
+  InvalidCounts fresh{};
+  bool any = false;
+  for (std::size_t i = 0; i < fresh.size(); ++i) {
+    fresh[i] = counters_.invalid[i] - logged_invalid_[i];
+    any |= fresh[i] != 0;
+  }
+  if (any)
+    spdlog::warn("rejected invalid frames: {}; the last from {}: {}: {}", format_invalid(fresh),
+                 last_rejected_sender_.to_string(), to_string(last_rejection_.category()),
+                 last_rejection_.message());
+  logged_invalid_ = counters_.invalid;
+}
+
+}  // namespace rsg::gateway

@@ -1,0 +1,99 @@
+// Ingress: raw frames from a UDP socket -> RobotState samples.
+//
+// Runs on the caller's thread (the gateway's main loop); everything it counts is read on that
+// same thread, so the hot path takes no lock. Per datagram it does one receive into a buffer
+// allocated at start-up, one decode, one copy of the payload into a loaned (or preallocated)
+// sample and one write; it allocates nothing and logs nothing.
+#pragma once
+
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rsg/frame.hpp"
+#include "rsg/gateway/clock.hpp"
+#include "rsg/gateway/link_monitor.hpp"
+#include "rsg/gateway/selection_requester.hpp"
+#include "rsg/gateway/sequence_tracker.hpp"
+#include "rsg/gateway/source_filter.hpp"
+#include "rsg/gateway/stats.hpp"
+#include "rsg/participant.hpp"
+#include "rsg/robot_state.hpp"
+#include "rsg/udp_socket.hpp"
+
+namespace rsg::gateway {
+
+class Ingress {
+ public:
+  struct Options {
+    Endpoint listen;
+    int receive_buffer = 0;
+    SourceFilter sources;
+    std::string topic;
+    std::vector<std::string> partitions;
+    std::string writer_profile;
+    Clock::duration nominal_period{};
+    std::uint64_t restart_threshold_ms = 0;
+    std::optional<Selection> requested_selection;
+    std::optional<Endpoint> robot;  ///< where selection requests go; unset: the frames' source
+  };
+
+  /// Binds the socket and creates the writer. Throws std::runtime_error / std::system_error.
+  Ingress(Participant& participant, Options options);
+  ~Ingress();
+  Ingress(const Ingress&) = delete;
+  Ingress& operator=(const Ingress&) = delete;
+
+  /// Sends the start-up selection request, if one is configured and the robot's address is known.
+  void start(Clock::time_point now);
+
+  /// Waits up to `timeout` for one datagram and handles it.
+  void receive_one(std::chrono::milliseconds timeout);
+
+  /// True once for every link change: up on a frame after silence, down on `poll` after silence.
+  bool link_changed(Clock::time_point now);
+  /// When `link_changed` must be asked next at the latest to notice silence in time.
+  Clock::time_point link_deadline() const { return link_.deadline(); }
+
+  /// Adds this side's counters to `stats`.
+  void fill(GatewayStats& stats) const;
+
+  /// Logs one line when frames were rejected since the last call (the caller calls it once a second).
+  void log_rejections();
+
+  Endpoint local_endpoint() const { return socket_.local_endpoint(); }
+
+ private:
+  void handle(std::size_t size, Clock::time_point now);
+  void publish(const FrameView& frame);
+  void request_selection(const Endpoint& robot, Clock::time_point now);
+
+  Options options_;
+  UdpSocket socket_;
+  Participant& participant_;
+  fdds::Publisher* publisher_ = nullptr;
+  fdds::DataWriter* writer_ = nullptr;
+  bool writer_loans_ = false;
+
+  // Larger than any UDP datagram, so oversized input reaches the decoder whole.
+  std::vector<std::uint8_t> datagram_;
+  Endpoint sender_;
+  RobotState fallback_sample_;  // when the writer cannot loan: the one preallocated sample
+
+  IngressCounters counters_;
+  SequenceTracker sequence_;
+  LinkMonitor link_;
+  bool link_came_up_ = false;
+  std::optional<SelectionRequester> requester_;
+  std::uint8_t request_packet_number_ = 0;
+
+  Endpoint source_;  // sender of the last valid frame
+  FrameError last_rejection_;
+  Endpoint last_rejected_sender_;
+  InvalidCounts logged_invalid_{};
+  std::uint64_t logged_rejected_source_ = 0;
+  Endpoint last_foreign_sender_;
+};
+
+}  // namespace rsg::gateway

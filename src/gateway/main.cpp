@@ -1,0 +1,132 @@
+// rsg_gateway: raw SEND_BUF frames over UDP <-> RobotState DDS samples. See gateway.hpp.
+//
+// Exit status: 0 after SIGINT/SIGTERM, 2 when the configuration (flags, file, profiles) is
+// unusable or the gateway cannot start; nothing has been created by then.
+#include <spdlog/sinks/stdout_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <csignal>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "gateway.hpp"
+#include "rsg/gateway/config.hpp"
+
+namespace {
+
+using rsg::gateway::GatewayConfig;
+
+constexpr int kExitUsage = 2;
+
+std::atomic<bool> stop_requested{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
+
+void request_stop(int) { stop_requested.store(true); }
+
+void install_stop_handlers() {
+  struct sigaction action {};
+  action.sa_handler = request_stop;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;  // no SA_RESTART: a blocking receive returns at once with EINTR
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+// Every config key becomes a long flag bound to `config`; CLI11 writes only the flags that are
+// given, so binding them to a configuration read from the file makes flags override the file.
+void add_config_flags(CLI::App& app, GatewayConfig& config, std::string& config_file) {
+  app.add_option("--config", config_file, "YAML file with the same keys as the long flags (flags win)");
+  for (const rsg::gateway::ConfigKey& key : rsg::gateway::config_keys()) {
+    const std::string flag = "--" + std::string(key.name);
+    const std::string help(key.help);
+    std::visit(
+        [&](auto member) {
+          CLI::Option* option = app.add_option(flag, config.*member, help);
+          if constexpr (std::is_same_v<decltype(member), std::vector<std::string> GatewayConfig::*>)
+            option->delimiter(',');
+          else
+            option->capture_default_str();
+        },
+        key.member);
+  }
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Flags, then the file under them. Returns the exit status when the process should not go on.
+std::optional<int> parse_command_line(int argc, char** argv, GatewayConfig& config) {
+  std::string config_file;
+  {
+    CLI::App app("rsg_gateway: robot-state frames over UDP <-> RobotState DDS samples", "rsg_gateway");
+    GatewayConfig flags_only;
+    add_config_flags(app, flags_only, config_file);
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::ParseError& error) {
+      if (error.get_exit_code() == 0) return app.exit(error);  // --help
+      std::cerr << "rsg_gateway: " << error.what() << " (see --help)\n";
+      return kExitUsage;
+    }
+    if (config_file.empty()) {
+      config = std::move(flags_only);
+      return std::nullopt;
+    }
+  }
+
+  std::string text;
+  try {
+    text = read_file(config_file);
+  } catch (const std::exception& error) {
+    std::cerr << "rsg_gateway: " << error.what() << '\n';
+    return kExitUsage;
+  }
+  const rsg::gateway::ConfigResult parsed = rsg::gateway::parse_gateway_config(text);
+  if (!parsed) {
+    std::cerr << "rsg_gateway: " << config_file;
+    if (parsed.error().line > 0) std::cerr << ':' << parsed.error().line;
+    std::cerr << ": " << parsed.error().message << '\n';
+    return kExitUsage;
+  }
+  config = parsed.config();
+  CLI::App app("rsg_gateway", "rsg_gateway");
+  add_config_flags(app, config, config_file);
+  app.parse(argc, argv);  // accepted once already
+  return std::nullopt;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  GatewayConfig config;
+  if (const auto exit_status = parse_command_line(argc, argv, config)) return *exit_status;
+
+  spdlog::set_default_logger(spdlog::stderr_logger_mt("rsg_gateway"));
+  spdlog::set_level(spdlog::level::from_str(config.log_level));
+
+  rsg::gateway::GatewaySetup setup;
+  try {
+    setup = rsg::gateway::prepare(config);
+  } catch (const std::exception& error) {
+    std::cerr << "rsg_gateway: " << error.what() << '\n';
+    return kExitUsage;
+  }
+
+  install_stop_handlers();
+  try {
+    rsg::gateway::Gateway gateway(setup);
+    gateway.run(stop_requested);
+  } catch (const std::exception& error) {
+    spdlog::error("cannot start: {}", error.what());
+    return kExitUsage;
+  }
+  return 0;
+}

@@ -1,0 +1,66 @@
+#include "rsg/gateway/sequence_tracker.hpp"
+
+#include "rsg/frame.hpp"
+
+namespace rsg::gateway {
+namespace {
+
+constexpr unsigned kModulo = kPacketNumberModulo;
+constexpr unsigned kWindow = 64;  // bits of `arrived_`; more than any distance a frame can have
+// Without time, a distance up to this counts as ahead, anything larger as behind.
+constexpr unsigned kMaxAheadWithoutTime = kModulo / 2;
+
+unsigned distance_ahead(std::uint8_t from, std::uint8_t to) { return (to - from + kModulo) % kModulo; }
+
+}  // namespace
+
+SequenceTracker::SequenceTracker(std::uint64_t restart_threshold_ms)
+    : restart_threshold_ms_(restart_threshold_ms) {}
+
+void SequenceTracker::observe(std::uint8_t packet_number, std::optional<std::uint64_t> time_ms) noexcept {
+  if (!started_) return start(packet_number, time_ms);
+
+  const unsigned ahead = distance_ahead(newest_packet_number_, packet_number);
+  if (!time_ms || !newest_time_ms_) {
+    if (ahead == 0) return arrive_late(0);
+    if (ahead <= kMaxAheadWithoutTime) return advance(ahead, packet_number, time_ms);
+    return arrive_late(kModulo - ahead);
+  }
+
+  if (*time_ms > *newest_time_ms_) return advance(ahead == 0 ? kModulo : ahead, packet_number, time_ms);
+  if (*time_ms == *newest_time_ms_) return arrive_late(0);
+  if (*newest_time_ms_ - *time_ms > restart_threshold_ms_) {
+    ++counts_.restarts;
+    return start(packet_number, time_ms);
+  }
+  const unsigned behind = distance_ahead(packet_number, newest_packet_number_);
+  arrive_late(behind == 0 ? kModulo : behind);
+}
+
+void SequenceTracker::start(std::uint8_t packet_number, std::optional<std::uint64_t> time_ms) noexcept {
+  started_ = true;
+  newest_packet_number_ = packet_number;
+  newest_time_ms_ = time_ms;
+  arrived_ = ~std::uint64_t{0};  // nothing before the first frame is missing
+}
+
+void SequenceTracker::advance(unsigned distance, std::uint8_t packet_number,
+                              std::optional<std::uint64_t> time_ms) noexcept {
+  counts_.lost += distance - 1;
+  arrived_ = (distance >= kWindow ? 0 : arrived_ << distance) | 1U;
+  newest_packet_number_ = packet_number;
+  newest_time_ms_ = time_ms;
+}
+
+void SequenceTracker::arrive_late(unsigned age) noexcept {
+  const std::uint64_t bit = std::uint64_t{1} << age;
+  if (arrived_ & bit) {
+    ++counts_.duplicated;
+    return;
+  }
+  arrived_ |= bit;
+  ++counts_.reordered;
+  --counts_.lost;  // it was counted lost when a later frame skipped it
+}
+
+}  // namespace rsg::gateway

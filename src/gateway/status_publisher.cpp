@@ -1,0 +1,36 @@
+#include "status_publisher.hpp"
+
+#include <GatewayStatusPubSubTypes.h>
+#include <spdlog/spdlog.h>
+
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <stdexcept>
+
+#include "rsg/gateway/status_sample.hpp"
+
+namespace rsg::gateway {
+
+StatusPublisher::StatusPublisher(Participant& participant, const std::string& topic,
+                                 const std::vector<std::string>& partitions, const std::string& profile)
+    : participant_(participant) {
+  publisher_ = participant_.publisher(partitions);
+  // TypeSupport takes ownership of the type object it is given.
+  fdds::Topic* status_topic = participant_.topic(topic, fdds::TypeSupport(new GatewayStatusPubSubType()));
+  writer_ = publisher_->create_datawriter_with_profile(status_topic, profile);
+  if (!writer_) {
+    participant_.get()->delete_publisher(publisher_);
+    throw std::runtime_error("cannot create the GatewayStatus writer with profile '" + profile + "'");
+  }
+}
+
+StatusPublisher::~StatusPublisher() {
+  publisher_->delete_datawriter(writer_);
+  participant_.get()->delete_publisher(publisher_);
+}
+
+void StatusPublisher::publish(const GatewayStats& stats) {
+  to_status_sample(stats, sample_);
+  if (!writer_->write(&sample_)) spdlog::warn("could not write the gateway status");
+}
+
+}  // namespace rsg::gateway

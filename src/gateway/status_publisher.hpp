@@ -1,0 +1,32 @@
+// Writes GatewayStatus samples (1 Hz and on link changes; never from the per-frame path).
+#pragma once
+
+#include <GatewayStatus.h>
+
+#include <string>
+#include <vector>
+
+#include "rsg/gateway/stats.hpp"
+#include "rsg/participant.hpp"
+
+namespace rsg::gateway {
+
+class StatusPublisher {
+ public:
+  /// Throws std::runtime_error when the writer cannot be created.
+  StatusPublisher(Participant& participant, const std::string& topic,
+                  const std::vector<std::string>& partitions, const std::string& profile);
+  ~StatusPublisher();
+  StatusPublisher(const StatusPublisher&) = delete;
+  StatusPublisher& operator=(const StatusPublisher&) = delete;
+
+  void publish(const GatewayStats& stats);
+
+ private:
+  Participant& participant_;
+  fdds::Publisher* publisher_ = nullptr;
+  fdds::DataWriter* writer_ = nullptr;
+  GatewayStatus sample_;
+};
+
+}  // namespace rsg::gateway

@@ -1,0 +1,38 @@
+#include "rsg/gateway/status_sample.hpp"
+
+#include <cstring>
+
+namespace rsg::gateway {
+namespace {
+
+// The IDL names each category so that DDS tools show them, and declares them in ErrorCategory
+// order; fastddsgen lays the members out as declared, so the counters are copied as one block.
+// tests/gateway/status_sample_test.cpp checks every name against its category.
+static_assert(sizeof(InvalidFrameCounts) == sizeof(InvalidCounts));
+
+void copy_invalid(const InvalidCounts& counts, InvalidFrameCounts& target) {
+  std::memcpy(static_cast<void*>(&target), counts.data(), sizeof counts);
+}
+
+}  // namespace
+
+void to_status_sample(const GatewayStats& stats, GatewayStatus& sample) {
+  sample.source(stats.source);  // fixed_string cuts what exceeds the bound
+  sample.link_up(stats.link_up);
+  sample.rate_hz(stats.rate_hz);
+  sample.frames_received(stats.ingress.received);
+  sample.frames_published(stats.ingress.published);
+  sample.publish_failed(stats.ingress.publish_failed);
+  copy_invalid(stats.ingress.invalid, sample.invalid());
+  sample.rejected_source(stats.ingress.rejected_source);
+  sample.lost(stats.sequence.lost);
+  sample.duplicated(stats.sequence.duplicated);
+  sample.reordered(stats.sequence.reordered);
+  sample.robot_restarts(stats.sequence.restarts);
+  sample.egress_samples(stats.egress.samples);
+  sample.egress_frames_sent(stats.egress.frames_sent);
+  sample.egress_unencodable(stats.egress.unencodable);
+  sample.egress_send_failed(stats.egress.send_failed);
+}
+
+}  // namespace rsg::gateway
