@@ -13,6 +13,7 @@ struct JointState {
   panda::Vector7d position;
   panda::Vector7d velocity;
   panda::Vector7d acceleration;
+  panda::Vector7d jerk;  ///< for torque rates: the inertial torque changes with it
 };
 
 /// Each joint moves as a sum of a few sines around the ready pose. Sines make the derivatives exact

@@ -44,8 +44,17 @@ struct Kinematics {
 
   /// Linear and angular velocity of the end effector in O for joint velocities `dq`.
   Vector6d twist(const Vector7d& dq) const;
+  /// Time derivative of `twist` while the joints move with `dq` and accelerate with `ddq`.
+  Vector6d twist_rate(const Vector7d& dq, const Vector7d& ddq) const;
   /// Joint torques that hold the arm (with the hand) against gravity.
   Vector7d gravity_torque() const;
+  /// Time derivative of `gravity_torque` while the joints move with `dq`.
+  Vector7d gravity_torque_rate(const Vector7d& dq) const;
+
+  Eigen::Vector3d axis(std::size_t i) const { return joint[i].linear().col(2); }
+  Eigen::Vector3d origin(std::size_t i) const { return joint[i].translation(); }
+  /// Velocity of the point `x` fixed to the link after joint `joints - 1` (moved by joints 0..joints-1).
+  Eigen::Vector3d point_velocity(const Eigen::Vector3d& x, std::size_t joints, const Vector7d& dq) const;
 };
 
 /// Forward kinematics from the modified (Craig) DH parameters Franka publishes.

@@ -58,16 +58,18 @@ JointTrajectory::JointTrajectory(std::uint64_t seed) {
 }
 
 JointState JointTrajectory::at(double t) const {
-  JointState state{eigen::joints(panda::kReadyPose), Vector7d::Zero(), Vector7d::Zero()};
+  JointState state{eigen::joints(panda::kReadyPose), Vector7d::Zero(), Vector7d::Zero(), Vector7d::Zero()};
   for (const Harmonic& harmonic : harmonics_) {
     for (Eigen::Index joint = 0; joint < harmonic.amplitude.size(); ++joint) {
       const double amplitude = harmonic.amplitude[joint];
       const double omega = harmonic.omega[joint];
       const double angle = omega * t + harmonic.phase[joint];
       const double sine = std::sin(angle);
+      const double cosine = std::cos(angle);
       state.position[joint] += amplitude * sine;
-      state.velocity[joint] += amplitude * omega * std::cos(angle);
+      state.velocity[joint] += amplitude * omega * cosine;
       state.acceleration[joint] -= amplitude * omega * omega * sine;
+      state.jerk[joint] -= amplitude * omega * omega * omega * cosine;
     }
   }
   return state;

@@ -17,8 +17,6 @@ using panda::Vector7d;
 const Vector7d kJointInertia = (Vector7d() << 0.6, 1.8, 0.5, 0.6, 0.03, 0.04, 0.01).finished();
 // Joint stiffness between motor and link (Nm/rad): the motor leads the link by tau / K.
 constexpr double kJointStiffness = 2.0e4;
-// Step of the central differences that give torque rates and Cartesian accelerations.
-constexpr double kDifferenceStep = 5e-4;
 constexpr std::uint64_t kRobotModeMove = 2;
 constexpr double kCommandSuccessRate = 1.0;
 
@@ -79,34 +77,10 @@ Eigen::Vector2d elbow_rate(const Vector7d& rate) { return {rate[2], 0}; }
 
 void PandaModel::fill(std::chrono::nanoseconds since_start, const Selection& wanted, StateValues& out) const {
   const double t = std::chrono::duration<double>(since_start).count();
-  const double t_desired = t + kDesiredLeadSeconds;
   FieldWriter writer(wanted, out);
-
   const JointState measured = trajectory_.at(t);
-  const JointState desired = trajectory_.at(t_desired);
-  const panda::Kinematics kinematics = panda::forward_kinematics(measured.position);
-  const panda::Kinematics desired_kinematics = panda::forward_kinematics(desired.position);
+  const JointState desired = trajectory_.at(t + kDesiredLeadSeconds);
 
-  // Link-side torque: holding the arm against gravity plus accelerating it.
-  const auto measured_torque = [this](double at) {
-    const JointState state = trajectory_.at(at);
-    return Vector7d(panda::forward_kinematics(state.position).gravity_torque() +
-                    kJointInertia.cwiseProduct(state.acceleration));
-  };
-  const auto desired_twist = [this](double at) {
-    const JointState state = trajectory_.at(at);
-    return panda::forward_kinematics(state.position).twist(state.velocity);
-  };
-  const Vector7d torque = kinematics.gravity_torque() + kJointInertia.cwiseProduct(measured.acceleration);
-  const Vector7d torque_rate =
-      writer.wants({Field::dtau_J, Field::dtheta})
-          ? Vector7d((measured_torque(t + kDifferenceStep) - measured_torque(t - kDifferenceStep)) /
-                     (2 * kDifferenceStep))
-          : Vector7d::Zero();
-  const Vector6d twist = desired_kinematics.twist(desired.velocity);
-
-  writer.put(Field::O_T_EE, kinematics.end_effector.matrix());
-  writer.put(Field::O_T_EE_d, desired_kinematics.end_effector.matrix());
   writer.put(Field::F_T_EE, panda::flange_to_end_effector().matrix());
   writer.put(Field::EE_T_K, Eigen::Matrix4d::Identity());
   writer.put(Field::m_ee, panda::kHandMass);
@@ -122,29 +96,42 @@ void PandaModel::fill(std::chrono::nanoseconds since_start, const Selection& wan
   writer.put(Field::elbow_c, elbow(desired.position));
   writer.put(Field::delbow_c, elbow_rate(desired.velocity));
   writer.put(Field::ddelbow_c, elbow_rate(desired.acceleration));
-  writer.put(Field::tau_J, torque);
   writer.put(Field::tau_J_d, kJointInertia.cwiseProduct(desired.acceleration));
-  writer.put(Field::dtau_J, torque_rate);
   writer.put(Field::q, measured.position);
   writer.put(Field::q_d, desired.position);
   writer.put(Field::dq, measured.velocity);
   writer.put(Field::dq_d, desired.velocity);
   writer.put(Field::ddq_d, desired.acceleration);
-  writer.put(Field::O_dP_EE_d, twist);
-  // A joint-space motion commands the desired trajectory as it is.
-  writer.put(Field::O_T_EE_c, desired_kinematics.end_effector.matrix());
-  writer.put(Field::O_dP_EE_c, twist);
-  if (writer.wants({Field::O_ddP_EE_c}))
-    writer.put(Field::O_ddP_EE_c,
-               (desired_twist(t_desired + kDifferenceStep) - desired_twist(t_desired - kDifferenceStep)) /
-                   (2 * kDifferenceStep));
-  writer.put(Field::theta, measured.position + torque / kJointStiffness);
-  writer.put(Field::dtheta, measured.velocity + torque_rate / kJointStiffness);
   writer.put(Field::control_command_success_rate, kCommandSuccessRate);
   writer.put_integer(Field::robot_mode, kRobotModeMove);
   writer.put_integer(
       Field::time,
       static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::milliseconds>(since_start).count()));
+
+  // Kinematics are the expensive part: only for the fields that need them.
+  if (writer.wants({Field::O_T_EE, Field::tau_J, Field::dtau_J, Field::theta, Field::dtheta})) {
+    const panda::Kinematics kinematics = panda::forward_kinematics(measured.position);
+    // Link-side torque: holding the arm against gravity plus accelerating it.
+    const Vector7d torque = kinematics.gravity_torque() + kJointInertia.cwiseProduct(measured.acceleration);
+    const Vector7d torque_rate =
+        kinematics.gravity_torque_rate(measured.velocity) + kJointInertia.cwiseProduct(measured.jerk);
+    writer.put(Field::O_T_EE, kinematics.end_effector.matrix());
+    writer.put(Field::tau_J, torque);
+    writer.put(Field::dtau_J, torque_rate);
+    writer.put(Field::theta, measured.position + torque / kJointStiffness);
+    writer.put(Field::dtheta, measured.velocity + torque_rate / kJointStiffness);
+  }
+  if (writer.wants(
+          {Field::O_T_EE_d, Field::O_T_EE_c, Field::O_dP_EE_d, Field::O_dP_EE_c, Field::O_ddP_EE_c})) {
+    const panda::Kinematics kinematics = panda::forward_kinematics(desired.position);
+    const Vector6d twist = kinematics.twist(desired.velocity);
+    writer.put(Field::O_T_EE_d, kinematics.end_effector.matrix());
+    writer.put(Field::O_dP_EE_d, twist);
+    // A joint-space motion commands the desired trajectory as it is.
+    writer.put(Field::O_T_EE_c, kinematics.end_effector.matrix());
+    writer.put(Field::O_dP_EE_c, twist);
+    writer.put(Field::O_ddP_EE_c, kinematics.twist_rate(desired.velocity, desired.acceleration));
+  }
 }
 
 }  // namespace rsg::sim
