@@ -7,7 +7,7 @@ namespace {
 
 constexpr unsigned kModulo = kPacketNumberModulo;
 constexpr unsigned kWindow = 64;  // bits of `arrived_`; more than any distance a frame can have
-// Without time, a distance up to this counts as ahead, anything larger as behind.
+// Without time, a frame further ahead than this may instead be a late one.
 constexpr unsigned kMaxAheadWithoutTime = kModulo / 2;
 
 unsigned distance_ahead(std::uint8_t from, std::uint8_t to) { return (to - from + kModulo) % kModulo; }
@@ -21,14 +21,15 @@ void SequenceTracker::observe(std::uint8_t packet_number, std::optional<std::uin
   if (!started_) return start(packet_number, time_ms);
 
   const unsigned ahead = distance_ahead(newest_packet_number_, packet_number);
-  if (!time_ms || !newest_time_ms_) {
+  // Above 1 kHz consecutive frames may share a millisecond: equal times leave it to the number.
+  if (!time_ms || !newest_time_ms_ || *time_ms == *newest_time_ms_) {
     if (ahead == 0) return arrive_late(0);
-    if (ahead <= kMaxAheadWithoutTime) return advance(ahead, packet_number, time_ms);
-    return arrive_late(kModulo - ahead);
+    // Behind only when that fills a known gap: a burst loss is never misread as old frames.
+    if (ahead > kMaxAheadWithoutTime && is_missing(kModulo - ahead)) return arrive_late(kModulo - ahead);
+    return advance(ahead, packet_number, time_ms);
   }
 
   if (*time_ms > *newest_time_ms_) return advance(ahead == 0 ? kModulo : ahead, packet_number, time_ms);
-  if (*time_ms == *newest_time_ms_) return arrive_late(0);
   if (*newest_time_ms_ - *time_ms > restart_threshold_ms_) {
     ++counts_.restarts;
     return start(packet_number, time_ms);
@@ -51,6 +52,8 @@ void SequenceTracker::advance(unsigned distance, std::uint8_t packet_number,
   newest_packet_number_ = packet_number;
   newest_time_ms_ = time_ms;
 }
+
+bool SequenceTracker::is_missing(unsigned age) const noexcept { return !((arrived_ >> age) & 1U); }
 
 void SequenceTracker::arrive_late(unsigned age) noexcept {
   const std::uint64_t bit = std::uint64_t{1} << age;

@@ -1,21 +1,25 @@
 // Lost, duplicated and reordered frames and robot restarts, from the 4-bit packet number.
 //
-// The packet number alone wraps every 16 frames, so on its own it can only place a frame within
-// 8 frames ahead of or 7 behind the newest one. When frames carry the robot's `time` (ms since
-// robot start, strictly increasing), time decides the direction instead and recognises restarts:
+// The packet number alone wraps every 16 frames, so on its own it cannot tell a frame 15 ahead
+// from one 1 behind. When frames carry the robot's `time` (ms since
+// robot start, never decreasing), time decides the direction instead and recognises restarts:
 //
-//   * Every frame gets an unwrapped sequence number relative to the newest frame seen so far.
-//     - without time: packet-number distance d = (pn - newest_pn) mod 16; d = 1..8 is ahead,
-//       d = 9..15 is 16-d behind, d = 0 is the newest frame again;
-//     - with time (this frame and the newest both carry it): time later than the newest is ahead
-//       by d (d = 0 meaning a full wrap, 16); the same time is the newest frame again; earlier
-//       time is behind by (newest_pn - pn) mod 16 (0 meaning 16); earlier by more than
-//       `restart_threshold_ms` is a robot restart.
+//   * Every frame is placed relative to the newest frame seen so far. With d = (pn - newest_pn)
+//     mod 16:
+//     - without time, or with the same time as the newest frame (above 1 kHz frames share a
+//       millisecond): d = 0 is the newest again; d = 9..15 is 16-d behind if that frame is
+//       missing (a late frame filling its gap), otherwise every d is ahead. So a late frame is
+//       recognised up to 7 behind, and a burst loss is never mistaken for old frames (it is
+//       counted modulo 16), but a duplicate of an older frame reads as a jump ahead;
+//     - time later than the newest: ahead by d (d = 0 meaning a full wrap, 16);
+//     - time earlier by at most `restart_threshold_ms`: behind by (newest_pn - pn) mod 16
+//       (0 meaning 16);
+//     - time earlier by more: a robot restart.
 //   * Ahead by d: the d-1 frames skipped are counted lost (a gap longer than 16 frames cannot be
-//     told from a shorter one: packet numbers only count modulo 16).
-//   * Behind: a bit window of the last 64 sequence numbers says whether that frame arrived
-//     already. If it did, the frame is a duplicate; if not, it arrives late: reordered, and no
-//     longer lost.
+//     told from a shorter one: packet numbers only count modulo 16; a pause where the robot sends
+//     nothing while its time runs on is not a loss).
+//   * Behind: a bit window of the last 64 positions says whether that frame arrived already. If
+//     it did, the frame is a duplicate; if not, it arrives late: reordered, and no longer lost.
 //   * Restart: counted, and the frame starts a fresh sequence (nothing lost across a restart).
 //
 // "Lost" therefore means "never arrived valid": frames dropped by the network and frames the
@@ -50,6 +54,7 @@ class SequenceTracker {
   void start(std::uint8_t packet_number, std::optional<std::uint64_t> time_ms) noexcept;
   void advance(unsigned distance, std::uint8_t packet_number, std::optional<std::uint64_t> time_ms) noexcept;
   void arrive_late(unsigned age) noexcept;
+  bool is_missing(unsigned age) const noexcept;
 
   std::uint64_t restart_threshold_ms_;
   Counts counts_;

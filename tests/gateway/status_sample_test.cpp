@@ -1,0 +1,88 @@
+#include "rsg/gateway/status_sample.hpp"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+namespace rsg::gateway {
+namespace {
+
+GatewayStats distinct_stats() {
+  GatewayStats stats;
+  stats.source = "192.0.2.1:40000";
+  stats.link_up = true;
+  stats.rate_hz = 999.5;
+  stats.ingress.received = 1;
+  stats.ingress.published = 2;
+  stats.ingress.publish_failed = 3;
+  for (std::size_t i = 0; i < stats.ingress.invalid.size(); ++i) stats.ingress.invalid[i] = 100 + i;
+  stats.ingress.rejected_source = 4;
+  stats.sequence = {.lost = 5, .duplicated = 6, .reordered = 7, .restarts = 8};
+  stats.egress = {.samples = 9, .frames_sent = 10, .unencodable = 11, .send_failed = 12};
+  return stats;
+}
+
+// The IDL names the invalid-frame counters; the mapping copies them by position.
+TEST(StatusSample, EveryCategoryLandsInTheMemberOfItsName) {
+  GatewayStatus sample;
+  to_status_sample(distinct_stats(), sample);
+  const InvalidFrameCounts& invalid = sample.invalid();
+  const auto at = [](ErrorCategory category) { return 100 + invalid_index(category); };
+  EXPECT_EQ(invalid.truncated(), at(ErrorCategory::kTruncated));
+  EXPECT_EQ(invalid.length_mismatch(), at(ErrorCategory::kLengthMismatch));
+  EXPECT_EQ(invalid.bad_crc(), at(ErrorCategory::kBadCrc));
+  EXPECT_EQ(invalid.bad_request(), at(ErrorCategory::kBadRequest));
+  EXPECT_EQ(invalid.reserved_bits(), at(ErrorCategory::kReservedBits));
+  EXPECT_EQ(invalid.selection_mismatch(), at(ErrorCategory::kSelectionMismatch));
+  EXPECT_EQ(invalid.bad_value(), at(ErrorCategory::kBadValue));
+}
+
+TEST(StatusSample, CountersAndLinkStateAreCopied) {
+  GatewayStatus sample;
+  to_status_sample(distinct_stats(), sample);
+  EXPECT_EQ(std::string(sample.source().c_str()), "192.0.2.1:40000");
+  EXPECT_TRUE(sample.link_up());
+  EXPECT_EQ(sample.rate_hz(), 999.5);
+  EXPECT_EQ(sample.frames_received(), 1U);
+  EXPECT_EQ(sample.frames_published(), 2U);
+  EXPECT_EQ(sample.publish_failed(), 3U);
+  EXPECT_EQ(sample.rejected_source(), 4U);
+  EXPECT_EQ(sample.lost(), 5U);
+  EXPECT_EQ(sample.duplicated(), 6U);
+  EXPECT_EQ(sample.reordered(), 7U);
+  EXPECT_EQ(sample.robot_restarts(), 8U);
+  EXPECT_EQ(sample.egress_samples(), 9U);
+  EXPECT_EQ(sample.egress_frames_sent(), 10U);
+  EXPECT_EQ(sample.egress_unencodable(), 11U);
+  EXPECT_EQ(sample.egress_send_failed(), 12U);
+}
+
+TEST(StatusSample, LongSourceIsCutToTheBound) {
+  GatewayStats stats;
+  stats.source = std::string(200, 'x');
+  GatewayStatus sample;
+  to_status_sample(stats, sample);
+  EXPECT_EQ(std::string(sample.source().c_str()).size(), 64U);
+}
+
+TEST(StatsJson, UsesTheStatusNamesAndCategoryNames) {
+  const auto json = nlohmann::json::parse(to_json(distinct_stats()));
+  EXPECT_EQ(json["frames_received"], 1);
+  EXPECT_EQ(json["lost"], 5);
+  EXPECT_EQ(json["robot_restarts"], 8);
+  EXPECT_EQ(json["invalid"]["truncated"], 100);
+  EXPECT_EQ(json["invalid"]["bad_value"], 106);
+  EXPECT_EQ(json["invalid"].size(), kErrorCategoryCount);
+  EXPECT_EQ(json["source"], "192.0.2.1:40000");
+}
+
+TEST(StatsSummary, NamesOnlyTheCategoriesThatOccurred) {
+  InvalidCounts counts{};
+  counts[invalid_index(ErrorCategory::kBadCrc)] = 3;
+  counts[invalid_index(ErrorCategory::kTruncated)] = 1;
+  EXPECT_EQ(format_invalid(counts), "truncated=1 bad_crc=3");
+  EXPECT_NE(summary_line(distinct_stats()).find("link up"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rsg::gateway
