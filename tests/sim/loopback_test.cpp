@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <sstream>
+#include <thread>
 
 #include "rsg/sim/simulator.hpp"
 #include "rsg/sim/udp_stream.hpp"

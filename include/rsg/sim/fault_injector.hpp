@@ -57,7 +57,7 @@ inline constexpr std::size_t kCraftedDatagramBytes = kMaxFrameBytes + 16;
 /// Writes to `out` (at least kCraftedDatagramBytes) a datagram that a spec-conformant decoder rejects
 /// with exactly `category`, made from the frame that `values` encodes to (its packet number and,
 /// where the category allows, its selection); `random` picks among the ways to break it.
-/// Returns the datagram's size.
+/// Returns the datagram's size. kNone gives the valid frame itself.
 std::size_t craft_invalid(ErrorCategory category, const StateValues& values, std::mt19937_64& random,
                           std::span<std::uint8_t> out);
 

@@ -1,6 +1,7 @@
 // Runs a Simulator on the wall clock and a UDP socket: what `rsg_sim` does once its options are read.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdint>

@@ -57,7 +57,7 @@ std::chrono::nanoseconds Simulator::step(DatagramSink& sink) {
         ++report_.duplicated;
       }
       // Released only behind a valid frame, so that a receiver can tell by the packet numbers.
-      if (holding_ && fault != Fault::kReorder) {
+      if (holding_) {
         emit(held_, sink);
         ++report_.reordered;
         holding_ = false;
