@@ -1,0 +1,304 @@
+// rsg_echo: subscribes to a RobotState topic, whole or through a group view, and prints what
+// arrives: one canonical JSON line per sample (--json), or a live table for a terminal.
+//
+// Exit status: 0 after --count samples or on SIGINT/SIGTERM, 1 on --timeout (no sample for that
+// many seconds, counted from start-up and from each sample) or a DDS failure, 2 on usage errors
+// (including unknown or malformed profiles).
+#include <RobotState.h>
+#include <pthread.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <csignal>
+#include <cstdio>
+#include <fastdds/dds/core/LoanableSequence.hpp>
+#include <fastdds/dds/core/condition/GuardCondition.hpp>
+#include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <iostream>
+#include <optional>
+#include <stop_token>
+#include <thread>
+
+#include "live_table.hpp"
+#include "rsg/json.hpp"
+#include "rsg/participant.hpp"
+#include "rsg/profiles.hpp"
+#include "rsg/robot_state.hpp"
+#include "rsg/selection.hpp"
+#include "rsg/views.hpp"
+
+namespace {
+
+namespace fdds = eprosima::fastdds::dds;
+using rsg::echo::Clock;
+
+enum ExitCode : int { kExitOk = 0, kExitFailure = 1, kExitUsage = 2 };
+
+// The table is redrawn at most this often, and the timeout checked as often.
+constexpr auto kRefreshPeriod = std::chrono::milliseconds(100);
+
+struct Options {
+  int domain = 0;
+  std::string topic = "robot_state";
+  std::vector<std::string> partitions;
+  std::string view_profile;
+  std::string groups;
+  std::string qos_profile;  // empty: reader_logger with --json, reader_realtime otherwise
+  bool json = false;
+  std::uint64_t count = 0;  // 0: no limit
+  double timeout_seconds = 0;
+  std::string profiles;
+};
+
+/// Turns SIGINT and SIGTERM into a trigger of `stop`. The signals are blocked in every thread
+/// (block_stop_signals runs before DDS starts its threads) and taken here synchronously, so no
+/// async-signal-unsafe code ever runs in a handler.
+class StopOnSignal {
+ public:
+  static void block_stop_signals() {
+    const sigset_t signals = stop_signals();
+    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  }
+
+  explicit StopOnSignal(fdds::GuardCondition& stop)
+      : thread_([&stop](std::stop_token token) {
+          const sigset_t signals = stop_signals();
+          const timespec poll{0, 100'000'000};  // to notice the stop request
+          while (!token.stop_requested())
+            if (sigtimedwait(&signals, nullptr, &poll) > 0) {
+              stop.set_trigger_value(true);
+              return;
+            }
+        }) {}
+
+ private:
+  static sigset_t stop_signals() {
+    sigset_t signals;
+    sigemptyset(&signals);
+    sigaddset(&signals, SIGINT);
+    sigaddset(&signals, SIGTERM);
+    return signals;
+  }
+
+  std::jthread thread_;
+};
+
+const char* policy_name(fdds::QosPolicyId_t id) {
+  switch (id) {
+    case fdds::DURABILITY_QOS_POLICY_ID:
+      return "DURABILITY";
+    case fdds::DEADLINE_QOS_POLICY_ID:
+      return "DEADLINE";
+    case fdds::LIVELINESS_QOS_POLICY_ID:
+      return "LIVELINESS";
+    case fdds::RELIABILITY_QOS_POLICY_ID:
+      return "RELIABILITY";
+    case fdds::OWNERSHIP_QOS_POLICY_ID:
+      return "OWNERSHIP";
+    case fdds::DATAREPRESENTATION_QOS_POLICY_ID:
+      return "DATA_REPRESENTATION";
+    default:
+      return "another policy";
+  }
+}
+
+/// Prints samples one way or the other; both see every sample taken, in order.
+class SampleSink {
+ public:
+  SampleSink(bool json, std::string header) : json_(json), header_(std::move(header)) {}
+
+  void add(const rsg::RobotState& sample, Clock::time_point now) {
+    rsg::to_values(sample, values_);
+    if (json_) {
+      rsg::append_canonical_json(values_, pending_);
+      pending_ += '\n';
+    } else {
+      stats_.add(values_, now);
+    }
+  }
+
+  /// JSON: writes what is pending (once per batch, so a 1 kHz stream is not 1000 syscalls a
+  /// second, and a consumer never waits longer than a batch). Table: redraws when it is due.
+  void flush(Clock::time_point now, bool force_table = false) {
+    if (json_) {
+      std::fwrite(pending_.data(), 1, pending_.size(), stdout);
+      std::fflush(stdout);
+      pending_.clear();
+      return;
+    }
+    if (!force_table && now < next_draw_) return;
+    next_draw_ = now + kRefreshPeriod;
+    const std::string table = rsg::echo::render_table(header_, stats_, now);
+    if (interactive_) {
+      terminal_.draw(table);
+    } else if (force_table || now >= next_log_) {  // a log file gets one table a second
+      next_log_ = now + std::chrono::seconds(1);
+      std::fwrite(table.data(), 1, table.size(), stdout);
+      std::fflush(stdout);
+    }
+  }
+
+ private:
+  bool json_;
+  std::string header_;
+  rsg::StateValues values_;
+  std::string pending_;
+  rsg::echo::StreamStats stats_;
+  rsg::echo::TerminalTable terminal_;
+  bool interactive_ = ::isatty(STDOUT_FILENO) != 0;
+  Clock::time_point next_draw_;
+  Clock::time_point next_log_;
+};
+
+void add_options(CLI::App& app, Options& options) {
+  app.add_option("--domain", options.domain, "DDS domain id")
+      ->check(CLI::Range(0, 232))
+      ->capture_default_str();
+  app.add_option("--topic", options.topic, "RobotState topic")->capture_default_str();
+  app.add_option("--partition", options.partitions, "DDS partition (repeatable; default: none)");
+  auto* view = app.add_option("--view", options.view_profile,
+                              "View profile, e.g. view_joints: only samples carrying its groups");
+  auto* groups = app.add_option("--groups", options.groups,
+                                "Only samples carrying all these groups, e.g. 2,3 (an ad-hoc view)");
+  view->excludes(groups);
+  app.add_option("--qos", options.qos_profile,
+                 "Reader QoS profile (default: reader_logger with --json, reader_realtime otherwise)");
+  app.add_flag("--json", options.json,
+               "One canonical JSON line per sample (as rsg_frame decode prints the frame); never "
+               "drops samples at 1 kHz with the default reliable reader");
+  app.add_option("--count", options.count, "Exit 0 after this many samples (default: no limit)");
+  app.add_option("--timeout", options.timeout_seconds,
+                 "Exit 1 when no sample arrives for this many seconds, from start-up or the last "
+                 "sample (default: wait forever)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--profiles", options.profiles, "XML profile file or directory")
+      ->default_str(rsg::default_profiles_dir().string());
+}
+
+/// What the reader reads: a view, or the whole topic.
+std::optional<rsg::View> requested_view(const Options& options, const fdds::Subscriber& subscriber) {
+  if (!options.view_profile.empty()) return rsg::load_view(subscriber, options.view_profile);
+  if (options.groups.empty()) return std::nullopt;
+  std::uint8_t mask = 0;
+  std::string error;
+  if (!rsg::parse_group_mask(options.groups, mask, error)) throw rsg::ViewError("--groups: " + error);
+  return rsg::group_view(mask);
+}
+
+int run(const Options& options) {
+  StopOnSignal::block_stop_signals();
+  rsg::Participant participant(options.domain, "rsg_participant");
+  fdds::Topic& topic = *participant.robot_state_topic(options.topic);
+  fdds::Subscriber& subscriber = *participant.subscriber(options.partitions);
+
+  const std::string qos_profile = !options.qos_profile.empty() ? options.qos_profile
+                                  : options.json               ? rsg::kLoggerReaderProfile
+                                                               : rsg::kRealtimeReaderProfile;
+  const fdds::DataReaderQos qos = rsg::load_reader_qos(subscriber, qos_profile);
+  std::optional<rsg::ViewReader> view_reader;
+  fdds::DataReader* reader = nullptr;  // owned by view_reader, or by the participant
+  if (auto view = requested_view(options, subscriber)) {
+    view_reader.emplace(subscriber, topic, std::move(*view), qos);
+    reader = view_reader->get();
+  } else {
+    reader = subscriber.create_datareader(&topic, qos);
+    if (reader == nullptr) throw std::runtime_error("cannot create a reader on '" + options.topic + "'");
+  }
+  const std::string read_topic = view_reader ? view_reader->filtered_topic()->get_name() : options.topic;
+
+  std::string header = "rsg_echo  " + read_topic + "  domain " + std::to_string(options.domain);
+  for (const auto& partition : options.partitions) header += "  partition " + partition;
+  header += "  qos " + qos_profile;
+  SampleSink sink(options.json, header);
+
+  fdds::GuardCondition stop;
+  StopOnSignal stop_on_signal(stop);
+  fdds::StatusCondition& reader_condition = reader->get_statuscondition();
+  reader_condition.set_enabled_statuses(fdds::StatusMask::data_available()
+                                        << fdds::StatusMask::requested_incompatible_qos());
+  fdds::WaitSet waitset;
+  waitset.attach_condition(reader_condition);
+  waitset.attach_condition(stop);
+
+  const auto timeout =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.timeout_seconds));
+  auto last_sample = Clock::now();
+  std::uint64_t received = 0;
+  FASTDDS_SEQUENCE(RobotStateSeq, rsg::RobotState);
+  RobotStateSeq samples;
+  fdds::SampleInfoSeq infos;
+
+  while (true) {
+    fdds::ConditionSeq triggered;
+    waitset.wait(triggered,
+                 eprosima::fastrtps::Duration_t(
+                     0, static_cast<std::uint32_t>(std::chrono::nanoseconds(kRefreshPeriod).count())));
+    const auto now = Clock::now();
+    if (stop.get_trigger_value()) {
+      sink.flush(now, /*force_table=*/true);
+      return kExitOk;
+    }
+
+    fdds::RequestedIncompatibleQosStatus incompatible;
+    if (reader->get_requested_incompatible_qos_status(incompatible) == ReturnCode_t::RETCODE_OK &&
+        incompatible.total_count_change > 0)
+      std::cerr << "rsg_echo: a writer of '" << options.topic << "' does not match reader profile '"
+                << qos_profile << "': its " << policy_name(incompatible.last_policy_id)
+                << " offer is below this reader's request\n";
+
+    // Take everything available: at 1 kHz a wake-up finds several samples.
+    bool done = false;
+    while (!done && reader->take(samples, infos) == ReturnCode_t::RETCODE_OK) {
+      for (fdds::LoanableCollection::size_type i = 0; i < samples.length() && !done; ++i) {
+        if (!infos[i].valid_data) continue;
+        sink.add(samples[i], now);
+        last_sample = now;
+        done = options.count != 0 && ++received == options.count;
+      }
+      reader->return_loan(samples, infos);
+    }
+    sink.flush(now, done);
+    if (done) return kExitOk;
+    if (options.timeout_seconds > 0 && now - last_sample >= timeout) {
+      std::cerr << "rsg_echo: no sample on '" << read_topic << "' for " << options.timeout_seconds << " s\n";
+      return kExitFailure;
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Prints the RobotState samples of a topic, or of a group view of it.", "rsg_echo"};
+  app.footer(
+      "Views: view_poses (group 0), view_load_and_elbow (1), view_joints (2), view_contact (3), "
+      "view_cartesian_motor (4), view_status (5), view_kinematics (0,2), view_forces (2,3), view_full "
+      "(0..5); a sample passes when it carries all the view's groups.\n"
+      "Exit status: 0 after --count samples or on SIGINT/SIGTERM, 1 on --timeout or a DDS failure, 2 "
+      "usage error (including an unknown or malformed profile).");
+  Options options;
+  add_options(app, options);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+
+  try {
+    rsg::load_profiles(options.profiles.empty() ? rsg::default_profiles_dir()
+                                                : std::filesystem::path(options.profiles));
+  } catch (const std::exception& error) {
+    std::cerr << "rsg_echo: " << error.what() << '\n';
+    return kExitUsage;
+  }
+  try {
+    return run(options);
+  } catch (const rsg::ViewError& error) {
+    std::cerr << "rsg_echo: " << error.what() << '\n';
+    return kExitUsage;
+  } catch (const std::exception& error) {
+    std::cerr << "rsg_echo: " << error.what() << '\n';
+    return kExitFailure;
+  }
+}

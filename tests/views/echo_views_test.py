@@ -1,0 +1,169 @@
+#!/usr/bin/env python3
+"""Multi-process group views: rsg_echo processes on different views of one mixed-selection
+stream each print exactly the samples carrying all their groups, as canonical JSON identical to
+what was published; and rsg_echo's exit codes.
+
+The stream comes from the test publisher (rsg_views_publish), or, with --sim and --gateway, from
+rsg_sim through rsg_gateway. Python 3 standard library only.
+"""
+import argparse
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+ARGS = None
+
+# (echo arguments, groups a sample must all carry; 0 = every sample)
+VIEWS = [
+    (["--view", "view_joints"], 0b000100),
+    (["--view", "view_forces"], 0b001100),
+    (["--view", "view_kinematics"], 0b000101),
+    (["--groups", "3,5"], 0b101000),
+    (["--view", "view_full"], 0b111111),
+    ([], 0),
+]
+
+
+def test_domain():
+    return os.getpid() % 200 + 10
+
+
+def free_udp_port():
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def echo(*extra, partition="views_test", stdout=subprocess.PIPE):
+    """Starts rsg_echo. A whole stream of JSON overflows a pipe that nobody reads while the test
+    waits for the publisher, so long outputs go to a file (`stdout`)."""
+    command = [ARGS.echo, "--domain", str(test_domain()), "--topic", "robot_state", "--partition", partition,
+               *extra]
+    return subprocess.Popen(command, stdout=stdout, stderr=subprocess.PIPE, text=True)
+
+
+def wanted(records, groups):
+    return [line for line in records if json.loads(line)["group_select"] & groups == groups]
+
+
+class EchoViews(unittest.TestCase):
+    def check_views(self, start_stream, records_file):
+        """Starts one rsg_echo per view, then the stream; each must print exactly its subset."""
+        # The expected counts are known only once the stream is recorded, so each echo runs
+        # until the stream ends (--timeout) rather than for --count samples.
+        with tempfile.TemporaryDirectory() as tmp:
+            echoes = []
+            for index, (view_args, groups) in enumerate(VIEWS):
+                output = open(os.path.join(tmp, f"echo{index}.jsonl"), "w+")
+                echoes.append((echo(*view_args, "--json", "--timeout", "5", stdout=output), output, view_args,
+                               groups))
+            stream = start_stream(len(echoes))
+            _, stream_err = stream.communicate(timeout=300)
+            self.assertEqual(stream.returncode, 0, stream_err)
+            with open(records_file) as f:
+                records = f.read().splitlines()
+            self.assertGreater(len(records), 0)
+            for process, output, view_args, groups in echoes:
+                _, err = process.communicate(timeout=60)
+                output.seek(0)
+                printed = output.read().splitlines()
+                output.close()
+                with self.subTest(view=view_args):
+                    self.assertEqual(process.returncode, 1, "expected the idle timeout after the stream: " + err)
+                    expected = wanted(records, groups)
+                    self.assertGreater(len(expected), 0, "the stream does not exercise this view")
+                    # Same text: both sides print with rsg's canonical JSON writer.
+                    self.assertEqual(printed, expected)
+
+    def test_views_of_the_test_publisher_stream(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            record = os.path.join(tmp, "published.jsonl")
+
+            def start(readers):
+                return subprocess.Popen(
+                    [ARGS.publish, "--domain", str(test_domain()), "--topic", "robot_state",
+                     "--partition", "views_test", "--readers", str(readers), "--count", "256",
+                     "--rate", "1000", "--record", record],
+                    stderr=subprocess.PIPE, text=True)
+
+            self.check_views(start, record)
+
+    @unittest.skipUnless(os.environ.get("RSG_SIM") and os.environ.get("RSG_GATEWAY"),
+                         "rsg_sim and rsg_gateway not built")
+    def test_views_of_the_sim_stream_through_the_gateway(self):
+        port = free_udp_port()
+        gateway = subprocess.Popen(
+            [os.environ["RSG_GATEWAY"], "--listen", f"127.0.0.1:{port}", "--domain", str(test_domain()),
+             "--topic", "robot_state", "--partition", "views_test"],
+            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        try:
+            with tempfile.TemporaryDirectory() as tmp:
+                record = os.path.join(tmp, "sent.jsonl")
+
+                def start(readers):
+                    time.sleep(3)  # discovery between the gateway and the echoes; not a pass/fail threshold
+                    return subprocess.Popen(
+                        [os.environ["RSG_SIM"], "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "2000",
+                         "--every", "1:g2", "--every", "3:g3", "--every", "10:g0,g5", "--every", "50:all",
+                         "--record", record],
+                        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+
+                self.check_views(start, record)
+        finally:
+            gateway.send_signal(signal.SIGINT)
+            gateway.wait(timeout=30)
+
+    def test_count_then_exit_0(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            process = echo("--view", "view_joints", "--json", "--count", "5", "--timeout", "60")
+            publisher = subprocess.run(
+                [ARGS.publish, "--domain", str(test_domain()), "--topic", "robot_state", "--partition",
+                 "views_test", "--readers", "1", "--count", "64", "--record", os.path.join(tmp, "r.jsonl")],
+                capture_output=True, text=True, timeout=120)
+            out, err = process.communicate(timeout=60)
+            self.assertEqual(process.returncode, 0, err)
+            self.assertEqual(len(out.splitlines()), 5)
+            self.assertNotEqual(publisher.returncode, 2)
+
+    def test_idle_timeout_exits_1(self):
+        process = echo("--timeout", "1", partition="nobody_publishes_here")
+        _, err = process.communicate(timeout=60)
+        self.assertEqual(process.returncode, 1)
+        self.assertIn("no sample", err)
+
+    def test_sigint_exits_0(self):
+        process = echo("--view", "view_status", partition="nobody_publishes_here")
+        time.sleep(1)  # let it reach its wait loop; the exit code does not depend on this
+        process.send_signal(signal.SIGINT)
+        process.communicate(timeout=30)
+        self.assertEqual(process.returncode, 0)
+
+    def test_usage_errors_exit_2(self):
+        cases = {
+            "unknown view": ["--view", "view_no_such_thing"],
+            "not a view": ["--view", "reader_logger"],
+            "bad group": ["--groups", "2,9"],
+            "view and groups": ["--view", "view_joints", "--groups", "2"],
+            "unknown qos": ["--qos", "no_such_profile"],
+            "unknown option": ["--frobnicate"],
+        }
+        for name, extra in cases.items():
+            with self.subTest(name):
+                process = echo(*extra, "--timeout", "5")
+                _, err = process.communicate(timeout=60)
+                self.assertEqual(process.returncode, 2, err)
+                self.assertTrue(err.strip(), "no message on stderr")
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--echo", required=True)
+    parser.add_argument("--publish", required=True)
+    ARGS, rest = parser.parse_known_args()
+    unittest.main(argv=[sys.argv[0], *rest])
