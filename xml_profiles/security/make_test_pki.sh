@@ -70,14 +70,19 @@ fill() {
   printf '%s\n' "$text"
 }
 
+# Signs like Fast DDS verifies (PKCS7_verify with PKCS7_TEXT), and checks the result the same way.
 sign() {  # document signed_document
   openssl smime -sign -text -in "$1" -out "$2" -signer "$out/ca.pem" -inkey "$out/ca.key"
+  quietly openssl smime -verify -text -in "$2" -CAfile "$out/ca.pem" -out /dev/null
 }
 
+# The CA signs certificates and, as an S/MIME signer, the governance and permissions documents:
+# OpenSSL refuses an S/MIME signature by a certificate whose key usage lacks digitalSignature.
 new_key "$out/ca.key"
 quietly openssl req -x509 -new -key "$out/ca.key" -sha256 -days "$VALID_DAYS" -set_serial "$(random_serial)" \
   -subj "/O=rsg test/CN=rsg test CA" \
-  -addext "basicConstraints=critical,CA:TRUE" -addext "keyUsage=critical,keyCertSign,cRLSign" \
+  -addext "basicConstraints=critical,CA:TRUE" \
+  -addext "keyUsage=critical,keyCertSign,cRLSign,digitalSignature" \
   -out "$out/ca.pem"
 
 sign "$TEMPLATES/governance.xml" "$out/governance.p7s"
