@@ -48,6 +48,12 @@ EgressCounters Egress::counters() const {
           unencodable_.load(std::memory_order_relaxed), send_failed_.load(std::memory_order_relaxed)};
 }
 
+std::uint32_t Egress::matched_writers() const {
+  fdds::SubscriptionMatchedStatus matched;
+  reader_->get_subscription_matched_status(matched);
+  return static_cast<std::uint32_t>(matched.current_count);
+}
+
 void Egress::run() {
   fdds::ConditionSeq triggered;
   while (!stop_.get_trigger_value()) {

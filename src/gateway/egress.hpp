@@ -45,6 +45,8 @@ class Egress {
 
   /// The counters so far; safe from any thread.
   EgressCounters counters() const;
+  /// Writers of the egress topic currently matched.
+  std::uint32_t matched_writers() const;
 
  private:
   struct Destination {

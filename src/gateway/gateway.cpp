@@ -167,7 +167,10 @@ void Gateway::run(const std::atomic<bool>& stop) {
 GatewayStats Gateway::snapshot() const {
   GatewayStats stats;
   if (ingress_) ingress_->fill(stats);
-  if (egress_) stats.egress = egress_->counters();
+  if (egress_) {
+    stats.egress = egress_->counters();
+    stats.egress_writers = egress_->matched_writers();
+  }
   stats.rate_hz = stats.link_up ? rate_hz_ : 0.0;
   return stats;
 }

@@ -133,6 +133,9 @@ void Ingress::fill(GatewayStats& stats) const {
   stats.ingress = counters_;
   stats.sequence = sequence_.counts();
   stats.link_up = link_.up();
+  fdds::PublicationMatchedStatus matched;
+  writer_->get_publication_matched_status(matched);
+  stats.state_readers = static_cast<std::uint32_t>(matched.current_count);
   stats.source = source_.size() ? source_.to_string() : std::string();
 }
 

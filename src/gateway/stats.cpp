@@ -25,6 +25,8 @@ std::string to_json(const GatewayStats& stats) {
       {"publish_failed", stats.ingress.publish_failed},
       {"invalid", invalid},
       {"rejected_source", stats.ingress.rejected_source},
+      {"state_readers", stats.state_readers},
+      {"egress_writers", stats.egress_writers},
       {"lost", stats.sequence.lost},
       {"duplicated", stats.sequence.duplicated},
       {"reordered", stats.sequence.reordered},

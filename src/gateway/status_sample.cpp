@@ -14,6 +14,12 @@ void copy_invalid(const InvalidCounts& counts, InvalidFrameCounts& target) {
   std::memcpy(static_cast<void*>(&target), counts.data(), sizeof counts);
 }
 
+InvalidCounts copy_invalid(const InvalidFrameCounts& source) {
+  InvalidCounts counts;
+  std::memcpy(counts.data(), static_cast<const void*>(&source), sizeof counts);
+  return counts;
+}
+
 }  // namespace
 
 void to_status_sample(const GatewayStats& stats, GatewayStatus& sample) {
@@ -29,10 +35,35 @@ void to_status_sample(const GatewayStats& stats, GatewayStatus& sample) {
   sample.duplicated(stats.sequence.duplicated);
   sample.reordered(stats.sequence.reordered);
   sample.robot_restarts(stats.sequence.restarts);
+  sample.state_readers(stats.state_readers);
+  sample.egress_writers(stats.egress_writers);
   sample.egress_samples(stats.egress.samples);
   sample.egress_frames_sent(stats.egress.frames_sent);
   sample.egress_unencodable(stats.egress.unencodable);
   sample.egress_send_failed(stats.egress.send_failed);
+}
+
+GatewayStats from_status_sample(const GatewayStatus& sample) {
+  GatewayStats stats;
+  stats.source = sample.source().c_str();
+  stats.link_up = sample.link_up();
+  stats.rate_hz = sample.rate_hz();
+  stats.ingress.received = sample.frames_received();
+  stats.ingress.published = sample.frames_published();
+  stats.ingress.publish_failed = sample.publish_failed();
+  stats.ingress.invalid = copy_invalid(sample.invalid());
+  stats.ingress.rejected_source = sample.rejected_source();
+  stats.sequence = {.lost = sample.lost(),
+                    .duplicated = sample.duplicated(),
+                    .reordered = sample.reordered(),
+                    .restarts = sample.robot_restarts()};
+  stats.state_readers = sample.state_readers();
+  stats.egress_writers = sample.egress_writers();
+  stats.egress = {.samples = sample.egress_samples(),
+                  .frames_sent = sample.egress_frames_sent(),
+                  .unencodable = sample.egress_unencodable(),
+                  .send_failed = sample.egress_send_failed()};
+  return stats;
 }
 
 }  // namespace rsg::gateway

@@ -18,6 +18,8 @@ GatewayStats distinct_stats() {
   for (std::size_t i = 0; i < stats.ingress.invalid.size(); ++i) stats.ingress.invalid[i] = 100 + i;
   stats.ingress.rejected_source = 4;
   stats.sequence = {.lost = 5, .duplicated = 6, .reordered = 7, .restarts = 8};
+  stats.state_readers = 13;
+  stats.egress_writers = 14;
   stats.egress = {.samples = 9, .frames_sent = 10, .unencodable = 11, .send_failed = 12};
   return stats;
 }
@@ -51,10 +53,18 @@ TEST(StatusSample, CountersAndLinkStateAreCopied) {
   EXPECT_EQ(sample.duplicated(), 6U);
   EXPECT_EQ(sample.reordered(), 7U);
   EXPECT_EQ(sample.robot_restarts(), 8U);
+  EXPECT_EQ(sample.state_readers(), 13U);
+  EXPECT_EQ(sample.egress_writers(), 14U);
   EXPECT_EQ(sample.egress_samples(), 9U);
   EXPECT_EQ(sample.egress_frames_sent(), 10U);
   EXPECT_EQ(sample.egress_unencodable(), 11U);
   EXPECT_EQ(sample.egress_send_failed(), 12U);
+}
+
+TEST(StatusSample, ReadsBackWhatItWrote) {
+  GatewayStatus sample;
+  to_status_sample(distinct_stats(), sample);
+  EXPECT_EQ(to_json(from_status_sample(sample)), to_json(distinct_stats()));
 }
 
 TEST(StatusSample, LongSourceIsCutToTheBound) {

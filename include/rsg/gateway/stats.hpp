@@ -39,6 +39,8 @@ struct EgressCounters {
 
 struct GatewayStats {
   IngressCounters ingress;
+  std::uint32_t state_readers = 0;   ///< readers matched by the RobotState writer
+  std::uint32_t egress_writers = 0;  ///< writers matched by the egress reader
   SequenceTracker::Counts sequence;
   EgressCounters egress;
   double rate_hz = 0;  ///< valid frames per second over the last status period

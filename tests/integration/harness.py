@@ -1,0 +1,160 @@
+"""Shared plumbing of the multi-process tests: binaries, ports, DDS domains, child processes.
+
+Every test gets its own DDS domain and its own UDP ports, so tests never see each other's
+traffic; every child process is killed when the test ends, passed or not; every wait is bounded.
+"""
+
+import argparse
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+SKIP = 77  # ctest SKIP_RETURN_CODE
+
+# Generous on purpose: a 2-core machine shared with builds makes discovery and start-up slow.
+DEFAULT_WAIT_S = 20.0
+
+
+class TestFailure(Exception):
+    pass
+
+
+def check(condition, message):
+    if not condition:
+        raise TestFailure(message)
+
+
+def wait_for(predicate, what, timeout_s=DEFAULT_WAIT_S, interval_s=0.05):
+    """Polls `predicate` until it returns something truthy; fails naming `what` on timeout."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        result = predicate()
+        if result:
+            return result
+        if time.monotonic() > deadline:
+            raise TestFailure(f"timed out after {timeout_s:.0f} s waiting for {what}")
+        time.sleep(interval_s)
+
+
+def free_udp_port():
+    """A port no one is bound to right now (the kernel's pick for port 0)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def test_domain():
+    """A DDS domain of this test alone (ctest runs tests as separate processes)."""
+    return os.getpid() % 200 + 10
+
+
+def read_json(path):
+    try:
+        return json.loads(Path(path).read_text())
+    except (FileNotFoundError, json.JSONDecodeError):
+        return None
+
+
+def read_json_lines(path):
+    lines = Path(path).read_text().splitlines() if Path(path).exists() else []
+    return [json.loads(line) for line in lines if line.strip()]
+
+
+class Harness:
+    """Owns the children and the scratch directory of one test."""
+
+    def __init__(self, name):
+        parser = argparse.ArgumentParser()
+        parser.add_argument("--bin", required=True, help="directory of rsg_gateway, rsg_sim, rsg_echo")
+        self.args = parser.parse_args()
+        self.bin = Path(self.args.bin)
+        self.name = name
+        self.dir = Path(tempfile.mkdtemp(prefix=f"rsg_{name}_"))
+        self.domain = test_domain()
+        self.children = []
+
+    def binary(self, name):
+        path = self.bin / name
+        if not path.exists():
+            print(f"SKIP: {path} is not built", file=sys.stderr)
+            sys.exit(SKIP)
+        return str(path)
+
+    def start(self, label, argv):
+        """Starts a child with stdout and stderr in files of the scratch directory."""
+        stdout = open(self.dir / f"{label}.out", "wb")
+        stderr = open(self.dir / f"{label}.err", "wb")
+        print(f"[{self.name}] start {label}: {' '.join(argv)}", flush=True)
+        process = subprocess.Popen(argv, stdout=stdout, stderr=stderr)
+        self.children.append((label, process))
+        return process
+
+    def run(self, label, argv, timeout_s=45.0):
+        """Runs a child to completion; returns its exit status."""
+        process = self.start(label, argv)
+        try:
+            return process.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            raise TestFailure(f"{label} did not finish within {timeout_s:.0f} s")
+
+    def wait(self, label, process, timeout_s=DEFAULT_WAIT_S):
+        try:
+            return process.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            raise TestFailure(f"{label} did not exit within {timeout_s:.0f} s")
+
+    def stop(self, label, process):
+        """SIGTERM, as an operator would; the gateway must exit 0."""
+        process.send_signal(signal.SIGTERM)
+        return self.wait(label, process)
+
+    def output(self, label):
+        return self.dir / f"{label}.out"
+
+    def gateway(self, label, *flags):
+        stats = self.dir / f"{label}.stats.json"
+        argv = [self.binary("rsg_gateway"), "--domain", str(self.domain), "--stats-file", str(stats), *flags]
+        return self.start(label, argv), stats
+
+    def cleanup(self):
+        for label, process in self.children:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+        subprocess.run(["fastdds", "shm", "clean"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    def dump_logs(self):
+        for label, _ in self.children:
+            for suffix in ("err", "out"):
+                path = self.dir / f"{label}.{suffix}"
+                if path.exists() and path.stat().st_size:
+                    text = path.read_text(errors="replace").splitlines()
+                    print(f"--- {label}.{suffix} (last 30 lines)")
+                    print("\n".join(text[-30:]))
+
+
+def main(name, body):
+    """Runs `body(harness)`; exit 0 on success, 1 on failure (with the children's logs)."""
+    harness = Harness(name)
+    subprocess.run(["fastdds", "shm", "clean"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        body(harness)
+        print(f"[{name}] passed")
+        return 0
+    except TestFailure as failure:
+        print(f"[{name}] FAILED: {failure}")
+        harness.dump_logs()
+        return 1
+    finally:
+        harness.cleanup()
+
+
+def wait_for_stats(stats_path, predicate, what, timeout_s=DEFAULT_WAIT_S):
+    """Waits until the gateway's --stats-file satisfies `predicate`; returns the stats."""
+    return wait_for(lambda: (lambda s: s if s and predicate(s) else None)(read_json(stats_path)), what, timeout_s)

@@ -1,0 +1,74 @@
+"""raw -> DDS -> raw through two gateways (ingress on one, egress on the other): every frame
+comes out byte-identical. A tap between the sim and the first gateway records the bytes sent."""
+
+import socket
+import sys
+import threading
+
+from harness import check, main, wait_for, wait_for_stats, free_udp_port
+
+COUNT = 600
+RATE = "300"
+
+
+class UdpRelay(threading.Thread):
+    """Receives on `port`, records every datagram, forwards it to `forward_to` (when given)."""
+
+    def __init__(self, port, forward_to=None):
+        super().__init__(daemon=True)
+        self.socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4 << 20)
+        self.socket.bind(("127.0.0.1", port))
+        self.socket.settimeout(0.2)
+        self.forward_to = forward_to
+        self.datagrams = []
+        self.stopping = False
+
+    def run(self):
+        while not self.stopping:
+            try:
+                datagram, _ = self.socket.recvfrom(65536)
+            except socket.timeout:
+                continue
+            self.datagrams.append(datagram)
+            if self.forward_to:
+                self.socket.sendto(datagram, self.forward_to)
+
+    def stop(self):
+        self.stopping = True
+        self.join()
+        self.socket.close()
+
+
+def body(h):
+    ingress_port, tap_port, sink_port = free_udp_port(), free_udp_port(), free_udp_port()
+    ingress, ingress_stats = h.gateway("ingress", "--listen", f"127.0.0.1:{ingress_port}", "--topic", "arm",
+                                       "--expected-rate", RATE)
+    egress, egress_stats = h.gateway("egress", "--egress-topic", "arm", "--send-to", f"127.0.0.1:{sink_port}",
+                                     "--status-topic", "egress_status")
+    sink = UdpRelay(sink_port)
+    tap = UdpRelay(tap_port, forward_to=("127.0.0.1", ingress_port))
+    sink.start()
+    tap.start()
+    try:
+        wait_for_stats(ingress_stats, lambda s: s["state_readers"] >= 1, "the egress reader to match the ingress writer")
+        wait_for_stats(egress_stats, lambda s: s["egress_writers"] >= 1, "the egress reader to see the ingress writer")
+
+        # All fields (2137-byte frames), joints only, and a header-only frame now and then.
+        status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{tap_port}", "--rate", RATE,
+                               "--count", str(COUNT), "--every", "2:q,dq,tau_J,time", "--every", "5:all"])
+        check(status == 0, f"rsg_sim exited {status}")
+        wait_for(lambda: len(sink.datagrams) >= COUNT, f"{COUNT} frames at the sink (have {len(sink.datagrams)})")
+    finally:
+        tap.stop()
+        sink.stop()
+
+    check(len(tap.datagrams) == COUNT, f"the tap saw {len(tap.datagrams)} datagrams, not {COUNT}")
+    check(len(sink.datagrams) == COUNT, f"the sink got {len(sink.datagrams)} frames for {COUNT} sent")
+    for index, (sent, received) in enumerate(zip(tap.datagrams, sink.datagrams)):
+        check(sent == received, f"frame {index} differs: sent {sent.hex()[:80]}..., got {received.hex()[:80]}...")
+    check(h.stop("ingress", ingress) == 0 and h.stop("egress", egress) == 0, "a gateway did not exit 0")
+
+
+if __name__ == "__main__":
+    sys.exit(main("raw_roundtrip", body))

@@ -1,0 +1,67 @@
+"""Bad flags, files and profiles: one message naming the problem, exit status 2, and nothing
+started (the listening port is still free). Also: --allow-from rejects other senders."""
+
+import socket
+import sys
+
+from harness import check, main, read_json, wait_for_stats, free_udp_port
+
+
+def port_is_free(port):
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        try:
+            probe.bind(("127.0.0.1", port))
+            return True
+        except OSError:
+            return False
+
+
+def expect_refusal(h, label, flags, words):
+    port = free_udp_port()
+    status = h.run(label, [h.binary("rsg_gateway"), "--domain", str(h.domain), "--listen", f"127.0.0.1:{port}",
+                           *flags])
+    message = (h.dir / f"{label}.err").read_text()
+    check(status == 2, f"{label}: exit status {status}, expected 2 ({message.strip()})")
+    for word in words:
+        check(word in message, f"{label}: message does not name '{word}': {message.strip()}")
+    check(port_is_free(port), f"{label}: the listening port stayed bound")
+
+
+def body(h):
+    config = h.dir / "gateway.yaml"
+    config.write_text("domain: 3\ntopic: arm\nexpected-rat: 100\n")
+    expect_refusal(h, "unknown_key", ["--config", str(config)], [str(config) + ":3", "expected-rat"])
+    config.write_text("domain: 3\nexpected-rate: [1, 2]\n")
+    expect_refusal(h, "wrong_type", ["--config", str(config)], [str(config) + ":2", "expected-rate"])
+    expect_refusal(h, "missing_file", ["--config", str(h.dir / "absent.yaml")], ["absent.yaml"])
+    expect_refusal(h, "bad_flag", ["--domian", "3"], ["--domian"])
+    expect_refusal(h, "bad_group", ["--request-groups", "7"], ["--request-groups", "'7'"])
+    expect_refusal(h, "bad_network", ["--allow-from", "10.0.0.0/33"], ["--allow-from", "10.0.0.0/33"])
+    expect_refusal(h, "missing_profile", ["--writer-profile", "no_such_writer"], ["no_such_writer"])
+    broken = h.dir / "broken.xml"
+    broken.write_text("<dds><profiles><data_writer profile_name='x'>")
+    expect_refusal(h, "broken_profiles", ["--profiles", str(broken)], [str(broken)])
+
+    # Flags override the file: the file names a missing profile, the flag a good one.
+    config.write_text("writer-profile: no_such_writer\n")
+    expect_refusal(h, "file_value", ["--config", str(config)], ["no_such_writer"])
+    gateway, stats = h.gateway("overridden", "--listen", f"127.0.0.1:{free_udp_port()}", "--config", str(config),
+                               "--writer-profile", "rsg_state_writer")
+    wait_for_stats(stats, lambda s: True, "the gateway to start with the flag's profile")
+    check(h.stop("overridden", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+
+    # --allow-from: frames from 127.0.0.1 are not in 10.0.0.0/8.
+    port = free_udp_port()
+    gateway, stats = h.gateway("filtered", "--listen", f"127.0.0.1:{port}", "--allow-from", "10.0.0.0/8",
+                               "--allow-from", "::1")
+    wait_for_stats(stats, lambda s: True, "the gateway to start")
+    status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "200", "--count", "50"])
+    check(status == 0, f"rsg_sim exited {status}")
+    final = wait_for_stats(stats, lambda s: s["rejected_source"] >= 50, "50 rejected datagrams")
+    check(final["frames_received"] == 0 and final["frames_published"] == 0, f"filtered gateway published: {final}")
+    check(h.stop("filtered", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+    check(read_json(stats)["rejected_source"] == 50, "rejected_source changed after the stream ended")
+
+
+if __name__ == "__main__":
+    sys.exit(main("startup_errors", body))
