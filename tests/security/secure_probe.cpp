@@ -1,7 +1,8 @@
 // rsg_secure_probe: one end of the DDS Security tests, driven by security_test.py.
 //
 //   rsg_secure_probe publish|subscribe --profiles FILE [--profiles FILE...] --profile NAME
-//                                      --domain ID [--samples N] [--seed S] [--marker]
+//                                      --domain ID [--partition NAME] [--samples N] [--seed S]
+//                                      [--marker]
 //
 // Both ends derive the same samples from --seed, so the subscriber checks each one bit for bit
 // against its own copy and the values travel over DDS only. The publisher writes them once, at
@@ -61,9 +62,6 @@ constexpr std::uint64_t kMarkerBits = 0x4B41454C2D475352;
 constexpr double kMarker = std::bit_cast<double>(kMarkerBits);
 
 constexpr const char* kTopic = "robot_state";
-// A named partition, as the gateway uses, so that the tests also cover the permissions'
-// partition rules (Fast DDS grants only the default partition when a rule lists none).
-constexpr const char* kPartition = "security_probe";
 
 struct Options {
   std::vector<std::string> profile_files;
@@ -72,7 +70,13 @@ struct Options {
   std::size_t samples = 20;
   std::uint64_t seed = 1;
   bool marker = false;
+  std::string partition;  ///< empty: the default partition
 };
+
+std::vector<std::string> partitions(const Options& options) {
+  if (options.partition.empty()) return {};
+  return {options.partition};
+}
 
 /// The samples both ends agree on. With `marker`, every field is selected and every double is
 /// kMarker, so that each sample carries the pattern many times over.
@@ -277,7 +281,7 @@ int run(const Options& options, bool publishing) {
 
   bool endpoint_created = false;
   if (publishing) {
-    fdds::Publisher* publisher = participant.publisher({kPartition});
+    fdds::Publisher* publisher = participant.publisher(partitions(options));
     fdds::DataWriter* writer =
         publisher->create_datawriter(topic, writer_qos(*publisher, options.samples), &writer_events);
     if (writer != nullptr) {
@@ -289,7 +293,7 @@ int run(const Options& options, bool publishing) {
       }
     }
   } else {
-    fdds::Subscriber* subscriber = participant.subscriber({kPartition});
+    fdds::Subscriber* subscriber = participant.subscriber(partitions(options));
     endpoint_created =
         subscriber->create_datareader(topic, reader_qos(*subscriber), &reader_events) != nullptr;
   }
@@ -328,6 +332,7 @@ int main(int argc, char** argv) {
     command.add_option("--samples", options.samples, "number of samples")->capture_default_str();
     command.add_option("--seed", options.seed, "seed of the samples' values")->capture_default_str();
     command.add_flag("--marker", options.marker, "every double is the marker pattern");
+    command.add_option("--partition", options.partition, "DDS partition (default: the default partition)");
   };
   CLI::App* publish = app.add_subcommand("publish", "write the samples, then wait for stdin to close");
   CLI::App* subscribe =

@@ -48,9 +48,10 @@ class Probe:
     The probe lives until its standard input closes; stop() closes it, and kills the probe if it
     does not leave in time."""
 
-    def __init__(self, name, mode, profiles, profile, domain, marker=False):
+    def __init__(self, name, mode, profiles, profile, domain, partition, marker=False):
         self.name = name
-        command = [ARGS.probe, mode, "--profile", profile, "--domain", str(domain), "--samples", str(SAMPLES)]
+        command = [ARGS.probe, mode, "--profile", profile, "--domain", str(domain), "--partition", partition,
+                   "--samples", str(SAMPLES)]
         for file in profiles:
             command += ["--profiles", str(file)]
         if marker:
@@ -267,11 +268,14 @@ class Security(unittest.TestCase):
         Path(ARGS.work_dir).mkdir(parents=True, exist_ok=True)
         self.work = Path(self.enterContext(tempfile.TemporaryDirectory(
             dir=ARGS.work_dir, prefix=f"{self._testMethodName}-")))
+        # A named partition, as with `rsg_gateway --partition robot1`: Fast DDS grants a partition
+        # only when the permissions name it (the templates say "*").
+        self.partition = "robot1"
         self.pki = self.work / "pki"
         self.secure_profiles = make_pki(self.pki)
 
     def start(self, name, mode, profile, profiles=None, marker=False):
-        probe = Probe(name, mode, profiles or [self.secure_profiles], profile, self.domain, marker)
+        probe = Probe(name, mode, profiles or [self.secure_profiles], profile, self.domain, self.partition, marker)
         self.addCleanup(probe.stop)
         return probe
 
@@ -305,6 +309,10 @@ class Security(unittest.TestCase):
         self.assert_receives_every_sample_exactly(reader)
         self.assertEqual(gateway.matched_participants(), {reader.participant}, gateway.report())
         self.assertEqual(reader.matched_participants(), {gateway.participant}, reader.report())
+
+    def test_permitted_reader_in_the_default_partition_receives_exact_samples(self):
+        self.partition = ""  # the gateway's default
+        self.test_permitted_reader_receives_exact_samples()
 
     def test_unauthenticated_participant_is_not_matched(self):
         gateway = self.gateway()
