@@ -50,7 +50,7 @@ class FrameView {
 
   std::span<const std::uint8_t> bytes_;
   FrameHeader header_;
-  std::array<std::uint16_t, kFieldCount> offsets_{};  // into bytes_, valid where contains()
+  std::array<std::uint16_t, kGroupCount> group_offsets_{};  // into bytes_: where each group's data starts
 };
 
 /// Either a valid frame or the first check it failed.

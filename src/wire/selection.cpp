@@ -2,18 +2,10 @@
 
 #include <charconv>
 
+#include "group_bytes.hpp"
+
 namespace rsg {
 namespace {
-
-// Data bytes implied by each possible data_select byte of each group.
-constexpr auto kMaskBytes = [] {
-  std::array<std::array<std::uint16_t, 256>, kGroupCount> table{};
-  for (std::size_t group = 0; group < kGroupCount; ++group)
-    for (std::size_t mask = 0; mask < 256; ++mask)
-      for (const FieldInfo& field : kFields)
-        if (field.group == group && (mask & field.mask)) table[group][mask] += field.wire_bytes;
-  return table;
-}();
 
 template <class OnItem>
 bool for_each_item(std::string_view list, std::string& error, OnItem&& on_item) {
@@ -47,7 +39,8 @@ bool parse_group(std::string_view item, std::size_t& group, std::string& error) 
 
 std::uint16_t Selection::data_bytes() const {
   std::uint16_t total = 0;
-  for (std::size_t group = 0; group < kGroupCount; ++group) total += kMaskBytes[group][data_select[group]];
+  for (std::size_t group = 0; group < kGroupCount; ++group)
+    total += detail::kSelectedBytes[group][data_select[group]];
   return total;
 }
 
