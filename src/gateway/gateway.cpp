@@ -117,14 +117,15 @@ Gateway::Gateway(const GatewaySetup& setup)
 }
 
 void Gateway::run(const std::atomic<bool>& stop) {
-  auto now = Clock::now();
-  if (ingress_) ingress_->start(now);
-  rate_.update(0, now);
-  publish_status(snapshot());
-  auto next_status = now + kStatusPeriod;
-  auto next_summary = now + kSummaryPeriod;
+  const auto start = Clock::now();
+  if (ingress_) ingress_->start(start);
+  rate_.update(0, start);
+  status_.publish(snapshot());
+  auto next_status = start + kStatusPeriod;
+  next_summary_ = start + kSummaryPeriod;
 
   while (!stop.load(std::memory_order_relaxed)) {
+    // Wake for the next frame, the next status, or the moment silence means the link is down.
     const auto wake = ingress_ ? std::min(next_status, ingress_->link_deadline()) : next_status;
     const auto wait =
         std::clamp(std::chrono::ceil<milliseconds>(wake - Clock::now()), milliseconds(0), kLongestWait);
@@ -133,35 +134,38 @@ void Gateway::run(const std::atomic<bool>& stop) {
     else
       std::this_thread::sleep_for(wait);
 
-    now = Clock::now();
-    if (ingress_ && ingress_->link_changed(now)) {
-      const GatewayStats stats = snapshot();
-      spdlog::info("link {} ({})", stats.link_up ? "up" : "down", stats.source);
-      publish_status(stats);
-    }
-    if (now < next_status) continue;
-
-    next_status += kStatusPeriod;
-    if (next_status < now) next_status = now + kStatusPeriod;  // after a stall, do not catch up
-    if (ingress_) {
-      GatewayStats counted;
-      ingress_->fill(counted);
-      rate_hz_ = rate_.update(counted.ingress.published + counted.ingress.publish_failed, now);
-      ingress_->log_rejections();
-    }
-    const GatewayStats stats = snapshot();
-    publish_status(stats);
-    write_stats_file(stats);
-    if (now >= next_summary) {
-      next_summary = now + kSummaryPeriod;
-      spdlog::info("{}", summary_line(stats));
+    const auto now = Clock::now();
+    if (ingress_ && ingress_->link_changed(now)) on_link_change();
+    if (now >= next_status) {
+      on_status_period(now);
+      next_status = std::max(next_status + kStatusPeriod, now);  // after a stall, do not catch up
     }
   }
 
   const GatewayStats final_stats = snapshot();
-  publish_status(final_stats);
+  status_.publish(final_stats);
   write_stats_file(final_stats);
   spdlog::info("stopping: {}", summary_line(final_stats));
+}
+
+void Gateway::on_link_change() {
+  const GatewayStats stats = snapshot();
+  spdlog::info("link {} ({})", stats.link_up ? "up" : "down", stats.source);
+  status_.publish(stats);  // now, not at the next period: readers act on link changes
+}
+
+void Gateway::on_status_period(Clock::time_point now) {
+  if (ingress_) {
+    rate_hz_ = rate_.update(ingress_->valid_frames(), now);
+    ingress_->log_rejections();
+  }
+  const GatewayStats stats = snapshot();
+  status_.publish(stats);
+  write_stats_file(stats);
+  if (now >= next_summary_) {
+    next_summary_ = now + kSummaryPeriod;
+    spdlog::info("{}", summary_line(stats));
+  }
 }
 
 GatewayStats Gateway::snapshot() const {
@@ -174,8 +178,6 @@ GatewayStats Gateway::snapshot() const {
   stats.rate_hz = stats.link_up ? rate_hz_ : 0.0;
   return stats;
 }
-
-void Gateway::publish_status(const GatewayStats& stats) { status_.publish(stats); }
 
 void Gateway::write_stats_file(const GatewayStats& stats) const {
   if (config_.stats_file.empty()) return;

@@ -36,8 +36,9 @@ class Gateway {
   void run(const std::atomic<bool>& stop);
 
  private:
+  void on_link_change();
+  void on_status_period(Clock::time_point now);
   GatewayStats snapshot() const;
-  void publish_status(const GatewayStats& stats);
   void write_stats_file(const GatewayStats& stats) const;
 
   GatewayConfig config_;
@@ -47,6 +48,7 @@ class Gateway {
   std::optional<Egress> egress_;
   RateMeter rate_;
   double rate_hz_ = 0;
+  Clock::time_point next_summary_{};
 };
 
 }  // namespace rsg::gateway

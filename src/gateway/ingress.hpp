@@ -56,6 +56,9 @@ class Ingress {
   /// When `link_changed` must be asked next at the latest to notice silence in time.
   Clock::time_point link_deadline() const { return link_.deadline(); }
 
+  /// Frames that passed validation so far.
+  std::uint64_t valid_frames() const { return counters_.published + counters_.publish_failed; }
+
   /// Adds this side's counters to `stats`.
   void fill(GatewayStats& stats) const;
 
