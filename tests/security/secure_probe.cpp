@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "random_state.hpp"
+#include "rsg/hex.hpp"
 #include "rsg/json.hpp"
 #include "rsg/participant.hpp"
 #include "rsg/profiles.hpp"
@@ -96,19 +97,9 @@ std::vector<StateValues> make_samples(const Options& options) {
   return samples;
 }
 
-std::string marker_hex() {
-  // CDR serializes in the host's byte order, little-endian on every platform rsg runs on.
-  static_assert(std::endian::native == std::endian::little);
-  std::string hex;
-  for (int byte = 0; byte < 8; ++byte) {
-    constexpr std::array<char, 16> kDigits{'0', '1', '2', '3', '4', '5', '6', '7',
-                                           '8', '9', 'a', 'b', 'c', 'd', 'e', 'f'};
-    const auto value = static_cast<unsigned>(kMarkerBits >> (8 * byte)) & 0xFFU;
-    hex += kDigits[value >> 4];
-    hex += kDigits[value & 0xFU];
-  }
-  return hex;
-}
+/// The marker as CDR puts it on the wire: Fast DDS serializes in the host's byte order, so in the
+/// order it has in memory.
+std::string marker_hex() { return to_hex(std::bit_cast<std::array<std::uint8_t, sizeof kMarker>>(kMarker)); }
 
 std::string to_string(const rtps::GuidPrefix_t& prefix) {
   std::ostringstream text;
@@ -195,8 +186,7 @@ class WriterEvents : public fdds::DataWriterListener {
 /// same seed, in order: reliable transient-local delivery loses and reorders nothing.
 class ReaderEvents : public fdds::DataReaderListener {
  public:
-  ReaderEvents(EventLog& log, std::vector<StateValues> expected)
-      : log_(log), expected_(std::move(expected)) {}
+  ReaderEvents(EventLog& log, const std::vector<StateValues>& expected) : log_(log), expected_(expected) {}
 
   void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& status) override {
     emit_match(log_, status.current_count_change, status.last_publication_handle);
@@ -218,7 +208,7 @@ class ReaderEvents : public fdds::DataReaderListener {
 
  private:
   EventLog& log_;
-  const std::vector<StateValues> expected_;
+  const std::vector<StateValues>& expected_;
   std::size_t next_index_ = 0;
   RobotState sample_;  // reused: a RobotState is a few kilobytes
 };
@@ -260,7 +250,7 @@ void wait_for_stdin_to_close() {
   }
 }
 
-int run(const Options& options, bool publishing) {
+void run(const Options& options, bool publishing) {
   for (const auto& file : options.profile_files) load_profiles(file);
   // Participants start disabled; enable_with_listener enables ours.
   auto* factory = fdds::DomainParticipantFactory::get_instance();
@@ -270,10 +260,11 @@ int run(const Options& options, bool publishing) {
   factory->set_qos(factory_qos);
 
   // Listeners first: they must outlive the participant, whose threads call them until it is gone.
+  const std::vector<StateValues> samples = make_samples(options);
   EventLog log;
   ParticipantEvents participant_events(log);
   WriterEvents writer_events(log);
-  ReaderEvents reader_events(log, make_samples(options));
+  ReaderEvents reader_events(log, samples);
 
   Participant participant(options.domain, options.profile);
   enable_with_listener(participant, participant_events);
@@ -287,7 +278,7 @@ int run(const Options& options, bool publishing) {
     if (writer != nullptr) {
       endpoint_created = true;
       RobotState sample;
-      for (const StateValues& values : make_samples(options)) {
+      for (const StateValues& values : samples) {
         to_sample(values, sample);
         if (!writer->write(&sample)) throw std::runtime_error("cannot write a sample");
       }
@@ -304,7 +295,6 @@ int run(const Options& options, bool publishing) {
   // A refused endpoint is an outcome to report, not a reason to leave: the participant stays in
   // the domain so that the test can check what the others make of it.
   wait_for_stdin_to_close();
-  return 0;
 }
 
 void log_fast_dds_to_stderr() {
@@ -343,7 +333,8 @@ int main(int argc, char** argv) {
 
   log_fast_dds_to_stderr();
   try {
-    return run(options, publish->parsed());
+    run(options, publish->parsed());
+    return 0;
   } catch (const std::exception& error) {
     std::cerr << "rsg_secure_probe: " << error.what() << "\n";
     return 1;

@@ -10,7 +10,8 @@ permitted reader, started after X's would-be culprit, has received everything.
 Run by ctest (label `integration`), one test per entry; by hand, as root for the capture tests:
     tests/security/security_test.py --probe build-sec/bin/rsg_secure_probe \\
         --make-pki xml_profiles/security/make_test_pki.sh \\
-        --plain-profiles tests/security/plain_udp_profiles.xml --work-dir /tmp/rsg-security [-v] [-k NAME]
+        --plain-profiles tests/security/plain_udp_profiles.xml --work-dir /tmp/rsg-security \\
+        [-v] [Security.test_NAME ...]
 Exits 77 (ctest's "skipped") when a test was skipped and none failed. Standard library only.
 """
 
@@ -115,8 +116,8 @@ class Probe:
             samples if len(samples := [e for e in events if e["event"] == "sample"]) >= count else None))
 
     def wait_for_authentication(self, participant, status):
-        return self.wait_for_event(f"{status} authentication of {participant}", lambda event: (
-            event["event"] == "authentication" and event["participant"] == participant and event["status"] == status))
+        expected = {"event": "authentication", "participant": participant, "status": status}
+        return self.wait_for_event(f"{status} authentication of {participant}", lambda event: event == expected)
 
     def wait_for_log(self, what, text):
         return self.wait_for(what, lambda _, log: next((line for line in log if text in line), None))
@@ -193,7 +194,7 @@ class UdpCapture:
             return None
         header_bytes = (packet[0] & 0x0F) * 4
         if len(packet) < header_bytes + 8:
-            return None  # a later fragment: no UDP header; RTPS data sent between local addresses is never fragmented
+            return None  # a later fragment; RTPS between local addresses never fragments (lo's MTU is 64 kB)
         (destination_port,) = struct.unpack_from("!H", packet, header_bytes + 2)
         return packet[header_bytes + 8:] if destination_port in self.ports else None
 
@@ -228,6 +229,7 @@ def forge_permissions(pki, forged):
     permissions CA. Returns a profiles file with that participant, rsg_forged_intruder."""
     forged.mkdir()
     run_openssl("genpkey", "-algorithm", "EC", "-pkeyopt", "ec_paramgen_curve:P-256", "-out", forged / "ca.key")
+    # The genuine CA's name: names are not what Fast DDS verifies.
     run_openssl("req", "-x509", "-new", "-key", forged / "ca.key", "-sha256", "-days", "30",
                 "-subj", "/O=rsg test/CN=rsg test CA", "-addext", "basicConstraints=critical,CA:TRUE",
                 "-addext", "keyUsage=critical,keyCertSign,digitalSignature", "-out", forged / "ca.pem")
@@ -240,8 +242,9 @@ def forge_permissions(pki, forged):
         grant = grant.replace(f"@{placeholder}@", value)
     (forged / "permissions.xml").write_text(grant, encoding="utf-8")
     # Its participant verifies the governance with the forged CA too, so it signs a copy of that.
-    documents = {"permissions": forged / "permissions.xml", "governance": Path(ARGS.make_pki).parent / "governance.xml"}
-    for name, document in documents.items():
+    templates = Path(ARGS.make_pki).parent
+    for name, document in (("permissions", forged / "permissions.xml"),
+                           ("governance", templates / "governance.xml")):
         run_openssl("smime", "-sign", "-text", "-in", document, "-out", forged / f"{name}.p7s",
                     "-signer", forged / "ca.pem", "-inkey", forged / "ca.key")
 
@@ -275,7 +278,8 @@ class Security(unittest.TestCase):
         self.secure_profiles = make_pki(self.pki)
 
     def start(self, name, mode, profile, profiles=None, marker=False):
-        probe = Probe(name, mode, profiles or [self.secure_profiles], profile, self.domain, self.partition, marker)
+        probe = Probe(name, mode, profiles or [self.secure_profiles], profile, self.domain, self.partition,
+                      marker)
         self.addCleanup(probe.stop)
         return probe
 
