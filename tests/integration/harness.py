@@ -7,6 +7,7 @@ traffic; every child process is killed when the test ends, passed or not; every 
 import argparse
 import json
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -122,29 +123,35 @@ class Harness:
         argv = [self.binary("rsg_gateway"), "--domain", str(self.domain), "--stats-file", str(stats), *flags]
         return self.start(label, argv), stats
 
-    def cleanup(self):
+    def cleanup(self, keep_outputs):
+        """Kills every child still running; removes the scratch directory unless the test failed."""
         for label, process in self.children:
             if process.poll() is None:
                 process.kill()
                 process.wait()
         subprocess.run(["fastdds", "shm", "clean"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        if not keep_outputs:
+            shutil.rmtree(self.dir, ignore_errors=True)
 
     def dump_logs(self):
+        """The end of every child's stderr; stdout (JSON samples) stays in the scratch directory."""
+        print(f"(outputs are in {self.dir})")
         for label, _ in self.children:
-            for suffix in ("err", "out"):
-                path = self.dir / f"{label}.{suffix}"
-                if path.exists() and path.stat().st_size:
-                    text = path.read_text(errors="replace").splitlines()
-                    print(f"--- {label}.{suffix} (last 30 lines)")
-                    print("\n".join(text[-30:]))
+            path = self.dir / f"{label}.err"
+            if path.exists() and path.stat().st_size:
+                lines = path.read_text(errors="replace").splitlines()
+                print(f"--- {label}.err (last 20 lines)")
+                print("\n".join(line[:300] for line in lines[-20:]))
 
 
 def main(name, body):
     """Runs `body(harness)`; exit 0 on success, 1 on failure (with the children's logs)."""
     harness = Harness(name)
     subprocess.run(["fastdds", "shm", "clean"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    passed = False
     try:
         body(harness)
+        passed = True
         print(f"[{name}] passed")
         return 0
     except TestFailure as failure:
@@ -152,7 +159,7 @@ def main(name, body):
         harness.dump_logs()
         return 1
     finally:
-        harness.cleanup()
+        harness.cleanup(keep_outputs=not passed)
 
 
 def wait_for_stats(stats_path, predicate, what, timeout_s=DEFAULT_WAIT_S):

@@ -5,8 +5,10 @@ import sys
 
 from harness import (check, main, read_json, read_json_lines, wait_for, wait_for_stats, free_udp_port)
 
-COUNT = 700
-CORRUPT_EVERY = 4  # frames 3, 7, 11, ...: 175 invalid, cycling through the seven categories
+# Frames 3, 7, 11, ... 699 are corrupted: 175 invalid, cycling through the seven categories. The
+# last frame is valid: a gap at the very end is invisible to packet numbers.
+COUNT = 701
+CORRUPT_EVERY = 4
 VALID = COUNT - COUNT // CORRUPT_EVERY
 RATE = "500"
 COUNTERS = ("frames_received", "frames_published", "invalid", "rejected_source")
