@@ -61,11 +61,14 @@ random_serial() {
 }
 
 # Replaces every @NAME@ of the template on stdin by the value given as NAME=value.
+# Values are taken literally (quoted, so that bash 5.2 does not expand & in them).
 fill() {
-  local text
+  local text assignment name value
   text="$(cat)"
   for assignment in "$@"; do
-    text="${text//@${assignment%%=*}@/${assignment#*=}}"
+    name="${assignment%%=*}"
+    value="${assignment#*=}"
+    text="${text//"@${name}@"/"${value}"}"
   done
   printf '%s\n' "$text"
 }
