@@ -108,13 +108,12 @@ class SampleSink {
  public:
   SampleSink(bool json, std::string header) : json_(json), header_(std::move(header)) {}
 
-  void add(const rsg::RobotState& sample, Clock::time_point now) {
-    rsg::to_values(sample, values_);
+  void add(const rsg::StateValues& values, Clock::time_point now) {
     if (json_) {
-      rsg::append_canonical_json(values_, pending_);
+      rsg::append_canonical_json(values, pending_);
       pending_ += '\n';
     } else {
-      stats_.add(values_, now);
+      stats_.add(values, now);
     }
   }
 
@@ -142,7 +141,6 @@ class SampleSink {
  private:
   bool json_;
   std::string header_;
-  rsg::StateValues values_;
   std::string pending_;
   rsg::echo::StreamStats stats_;
   rsg::echo::TerminalTable terminal_;
@@ -228,6 +226,7 @@ int run(const Options& options) {
   FASTDDS_SEQUENCE(RobotStateSeq, rsg::RobotState);
   RobotStateSeq samples;
   fdds::SampleInfoSeq infos;
+  rsg::StateValues values;
 
   while (true) {
     fdds::ConditionSeq triggered;
@@ -252,7 +251,11 @@ int run(const Options& options) {
     while (!done && reader->take(samples, infos) == ReturnCode_t::RETCODE_OK) {
       for (fdds::LoanableCollection::size_type i = 0; i < samples.length() && !done; ++i) {
         if (!infos[i].valid_data) continue;
-        sink.add(samples[i], now);
+        rsg::to_values(samples[i], values);
+        // A data-sharing loan points into the writer's history, which the writer may have reused
+        // for a newer sample before or while it was copied; such a copy is no sample at all.
+        if (!reader->is_sample_valid(&samples[i], &infos[i])) continue;
+        sink.add(values, now);
         last_sample = now;
         done = options.count != 0 && ++received == options.count;
       }
