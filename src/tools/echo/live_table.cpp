@@ -25,7 +25,7 @@ __attribute__((format(printf, 2, 3))) void append(std::string& out, const char* 
 
 // One labelled line per key value; "-" when the last sample did not carry the field.
 void append_field_line(std::string& out, const StateValues& values, Field field) {
-  append(out, "%-9s", std::string(info(field).name).c_str());
+  append(out, "%-11s", std::string(info(field).name).c_str());
   if (!values.selection.contains(field)) {
     out += "-\n";
     return;
@@ -33,7 +33,7 @@ void append_field_line(std::string& out, const StateValues& values, Field field)
   switch (field) {
     case Field::O_T_EE: {
       const auto pose = values.doubles(field);  // column-major 4x4: translation is column 3
-      append(out, "x %+.4f  y %+.4f  z %+.4f m\n", pose[12], pose[13], pose[14]);
+      append(out, "x %+.5g  y %+.5g  z %+.5g m\n", pose[12], pose[13], pose[14]);
       return;
     }
     case Field::robot_mode: {
@@ -47,7 +47,7 @@ void append_field_line(std::string& out, const StateValues& values, Field field)
       return;
     default:
       out += '[';
-      for (const double element : values.doubles(field)) append(out, " %+.4f", element);
+      for (const double element : values.doubles(field)) append(out, " %+.5g", element);
       out += " ]\n";
       return;
   }
