@@ -63,8 +63,10 @@ def read_json(path):
 
 
 def read_json_lines(path):
-    lines = Path(path).read_text().splitlines() if Path(path).exists() else []
-    return [json.loads(line) for line in lines if line.strip()]
+    """The complete lines of a file another process may still be writing."""
+    text = Path(path).read_text() if Path(path).exists() else ""
+    complete = text.split("\n")[:-1]  # the part after the last newline may be half written
+    return [json.loads(line) for line in complete if line.strip()]
 
 
 class Harness:

@@ -18,6 +18,8 @@ def body(h):
     gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", RATE)
     wait_for_stats(stats, lambda s: True, "the gateway to start")
     h.start("probe", [h.binary("rsg_status_probe"), "--domain", str(h.domain), "--timeout", "55"])
+    # The status writer is transient-local: a matched probe prints the current status at once.
+    wait_for(lambda: read_json_lines(h.output("probe")), "the status probe to match the gateway")
 
     report_path = h.dir / "sim.report.json"
     status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", RATE, "--count", "900",
