@@ -62,9 +62,9 @@ bool operator==(const Endpoint& a, const Endpoint& b) {
 UdpSocket UdpSocket::bind(const Endpoint& local) {
   const int fd = ::socket(local.family(), SOCK_DGRAM | SOCK_CLOEXEC, 0);
   if (fd < 0) throw std::system_error(errno, std::generic_category(), "socket()");
+  // No SO_REUSEADDR: on UDP it would let a second process bind the same port and silently take
+  // part of the stream. UDP has no TIME_WAIT, so a restarted gateway rebinds without it.
   UdpSocket socket(fd);
-  const int yes = 1;
-  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
   if (::bind(fd, local.address(), local.size()) != 0)
     throw std::system_error(errno, std::generic_category(), "cannot bind UDP " + local.to_string());
   return socket;

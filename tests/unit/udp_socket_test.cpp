@@ -47,6 +47,12 @@ TEST(UdpSocket, BindFailureNamesTheAddress) {
   }
 }
 
+TEST(UdpSocket, ASecondBindOfTheSamePortFails) {
+  // Two gateways on one port would each get part of the stream; the second must fail loudly.
+  UdpSocket first = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
+  EXPECT_THROW(UdpSocket::bind(first.local_endpoint()), std::system_error);
+}
+
 TEST(UdpSocket, MovesOwnershipOfTheDescriptor) {
   UdpSocket a = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
   const int fd = a.fd();
