@@ -1,0 +1,194 @@
+// rsg_bench_e2e: end-to-end latency, loss and cost of rsg_gateway, next to baselines measured on
+// the same machine with the same frames and the same QoS. tests/bench/run_bench.sh runs it as the
+// `e2e` suite; docs/benchmarks/e2e.md explains the method and shows the results.
+//
+//   rsg_bench_e2e --scenario gateway_udp [--rate 1000] [--duration 30] [--out FILE] [--cdf FILE]
+//   rsg_bench_e2e --smoke             a few hundred frames through the gateway: do they arrive?
+//   rsg_bench_e2e --role writer ...   (internal) the writer process of the plain Fast DDS baseline
+//
+// Every run has its own DDS domain (pid % 200 + 10), ports the kernel picks, and a scratch
+// directory for the children's logs (kept, and named, when the run fails).
+#include <sys/prctl.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <map>
+
+#include "rsg/profiles.hpp"
+#include "scenarios.hpp"
+
+namespace {
+
+using json = nlohmann::json;
+using rsg::bench::BenchOptions;
+using rsg::bench::transport_named;
+
+using Scenario = std::function<json(const BenchOptions&)>;
+
+std::map<std::string, Scenario> scenarios(const std::vector<double>& max_rate_steps) {
+  using namespace rsg::bench;
+  return {
+      {"gateway_udp", [](const BenchOptions& o) { return run_gateway(o, transport_named("udp")); }},
+      {"gateway_shm", [](const BenchOptions& o) { return run_gateway(o, transport_named("shm")); }},
+      {"gateway_datasharing",
+       [](const BenchOptions& o) { return run_gateway(o, transport_named("datasharing")); }},
+      {"baseline_udp_oneway", [](const BenchOptions& o) { return run_udp_oneway(o); }},
+      {"baseline_fastdds", [](const BenchOptions& o) { return run_fastdds(o, transport_named("udp")); }},
+      {"baseline_fastdds_shm", [](const BenchOptions& o) { return run_fastdds(o, transport_named("shm")); }},
+      {"baseline_fastdds_datasharing",
+       [](const BenchOptions& o) { return run_fastdds(o, transport_named("datasharing")); }},
+      {"cyclone_ddsperf", [](const BenchOptions& o) { return run_ddsperf(o); }},
+      {"max_rate", [max_rate_steps](const BenchOptions& o) { return run_max_rate(o, max_rate_steps); }},
+      // The RSS soak: a long gateway run over UDP (--duration 300).
+      {"soak", [](const BenchOptions& o) { return run_gateway(o, transport_named("udp")); }},
+  };
+}
+
+/// Logs and profile links of the children; removed at exit unless kept.
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::string name = (std::filesystem::temp_directory_path() / "rsg_bench_XXXXXX").string();
+    if (!::mkdtemp(name.data())) throw std::runtime_error("cannot create a scratch directory in /tmp");
+    path_ = name;
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    if (!keep_) std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+
+  const std::filesystem::path& path() const { return path_; }
+  void keep() { keep_ = true; }
+
+ private:
+  std::filesystem::path path_;
+  bool keep_ = false;
+};
+
+// rsg_gateway takes one profile file or directory, but needs the project's profiles (its writer
+// QoS) and the bench's (transport variants): a directory of links to both serves it and us.
+std::filesystem::path link_profiles(const std::filesystem::path& project_profiles,
+                                    const std::filesystem::path& bench_profiles,
+                                    const std::filesystem::path& scratch) {
+  const std::filesystem::path dir = scratch / "profiles";
+  std::filesystem::create_directory(dir);
+  for (const auto& entry : std::filesystem::directory_iterator(project_profiles))
+    if (entry.path().extension() == ".xml")
+      std::filesystem::create_symlink(std::filesystem::absolute(entry.path()), dir / entry.path().filename());
+  std::filesystem::create_symlink(std::filesystem::absolute(bench_profiles), dir / bench_profiles.filename());
+  return dir;
+}
+
+// For ctest: frames reach a subscriber through the gateway over UDP and by data-sharing, and
+// data-sharing really is used only when asked for. Nothing about timing is judged.
+int run_smoke(BenchOptions options) {
+  constexpr double kSmokeRate = 1000;
+  constexpr double kSmokeSeconds = 0.3;
+  options.rate_hz = kSmokeRate;
+  options.warmup_s = 0;
+  options.duration_s = kSmokeSeconds;
+  bool ok = true;
+  for (const std::string_view transport : {"udp", "datasharing"}) {
+    const json run = rsg::bench::run_gateway(options, transport_named(transport));
+    const bool arrived = run["received"].get<std::uint64_t>() > 0;
+    const bool data_sharing_as_asked = run["data_sharing_used"].get<bool>() == (transport == "datasharing");
+    std::cout << "smoke " << transport << ": " << run["received"] << " of " << run["sent"]
+              << " frames arrived, data-sharing "
+              << (run["data_sharing_used"].get<bool>() ? "used" : "not used") << '\n';
+    ok = ok && arrived && data_sharing_as_asked;
+  }
+  return ok ? 0 : 1;
+}
+
+std::filesystem::path own_directory() {
+  return std::filesystem::read_symlink("/proc/self/exe").parent_path();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  BenchOptions options;
+  options.domain = static_cast<int>(::getpid() % 200 + 10);
+  options.bin_dir = own_directory();
+  options.profiles_dir = rsg::default_profiles_dir();
+  std::filesystem::path bench_profiles = RSG_BENCH_PROFILES;
+  std::string scenario, role, transport = "udp", out;
+  std::vector<double> max_rate_steps = {1000, 2000, 5000, 10000, 20000, 50000, 100000};
+  std::uint64_t frames = 0;
+  bool smoke = false, keep_scratch = false;
+
+  CLI::App app("rsg_bench_e2e: end-to-end latency of rsg_gateway and its baselines", "rsg_bench_e2e");
+  std::vector<std::string> names;
+  for (const auto& entry : scenarios({})) names.push_back(entry.first);
+  app.add_option("--scenario", scenario, "What to measure")->check(CLI::IsMember(names));
+  app.add_flag("--smoke", smoke, "Send a few hundred frames through the gateway; fail unless they arrive");
+  app.add_option("--rate", options.rate_hz, "Frames per second")->capture_default_str();
+  app.add_option("--duration", options.duration_s, "Seconds measured (per step for max_rate)")
+      ->capture_default_str();
+  app.add_option("--warmup", options.warmup_s, "Seconds sent first and not measured")->capture_default_str();
+  app.add_option("--rates", max_rate_steps, "max_rate: the rates tried, in order")->delimiter(',');
+  app.add_option("--usage-period", options.usage_period_s, "Seconds between RSS/CPU samples of the gateway")
+      ->capture_default_str();
+  app.add_option("--out", out, "Write the result JSON here (default: stdout)");
+  app.add_option("--cdf", options.cdf_file, "Write the latency CDF here (latency_us fraction)");
+  app.add_option("--domain", options.domain, "DDS domain")->capture_default_str();
+  app.add_option("--profiles", options.profiles_dir, "The project's XML profiles (file or directory)");
+  app.add_option("--bench-profiles", bench_profiles, "The bench's transport profiles")->capture_default_str();
+  app.add_option("--ddsperf", options.ddsperf, "Cyclone DDS's ddsperf")->capture_default_str();
+  app.add_flag("--keep-scratch", keep_scratch, "Keep the children's logs and stats files");
+  app.add_option("--role", role, "(internal) run as the baseline's writer process")
+      ->check(CLI::IsMember({"writer"}));
+  app.add_option("--transport", transport, "(writer role) udp, shm or datasharing");
+  app.add_option("--topic", options.topic, "(writer role) topic name");
+  app.add_option("--frames", frames, "(writer role) samples to write");
+  CLI11_PARSE(app, argc, argv);
+
+  // The sender paces with absolute sleeps on this (the main) thread: without the kernel's default
+  // 50 us timer slack a 1 kHz frame leaves within a few us of its due time.
+  ::prctl(PR_SET_TIMERSLACK, 1UL);
+
+  if (role == "writer") {
+    try {
+      rsg::load_profiles(options.profiles_dir);
+      return rsg::bench::run_writer_role(options, transport_named(transport), frames);
+    } catch (const std::exception& error) {
+      std::cerr << "rsg_bench_e2e writer: " << error.what() << '\n';
+      return 1;
+    }
+  }
+  if (!smoke && scenario.empty()) {
+    std::cerr << "rsg_bench_e2e: give --scenario or --smoke (see --help)\n";
+    return 2;
+  }
+
+  ScratchDir scratch;
+  if (keep_scratch) scratch.keep();
+  try {
+    options.scratch_dir = scratch.path();
+    options.profiles_dir = link_profiles(options.profiles_dir, bench_profiles, scratch.path());
+    rsg::load_profiles(options.profiles_dir);
+    if (smoke) return run_smoke(options);
+
+    json result = scenarios(max_rate_steps).at(scenario)(options);
+    result["scenario"] = scenario;
+    if (out.empty()) {
+      std::cout << result.dump(2) << '\n';
+    } else {
+      std::ofstream file(out);
+      file << result.dump(2) << '\n';
+      if (!file) throw std::runtime_error(out + ": cannot write");
+    }
+    return 0;
+  } catch (const std::exception& error) {
+    scratch.keep();
+    std::cerr << "rsg_bench_e2e: " << (smoke ? "smoke" : scenario) << ": " << error.what()
+              << " (logs kept in " << scratch.path().string() << ")\n";
+    return 1;
+  }
+}

@@ -1,0 +1,24 @@
+// CPU time and resident memory of a process, as the kernel accounts them in /proc/PID.
+#pragma once
+
+#include <sys/types.h>
+
+#include <cstdint>
+
+#include "stamped_frames.hpp"
+
+namespace rsg::bench {
+
+struct ProcessUsage {
+  Clock::time_point at;
+  double cpu_seconds = 0;   ///< utime + stime: user and kernel time of all its threads
+  std::int64_t rss_kb = 0;  ///< VmRSS
+};
+
+/// Reads /proc/PID/stat and /proc/PID/status. Throws std::runtime_error when the process is gone.
+ProcessUsage read_usage(pid_t pid);
+
+/// CPU time between two readings as a percentage of one core's wall time.
+double cpu_percent(const ProcessUsage& from, const ProcessUsage& to);
+
+}  // namespace rsg::bench

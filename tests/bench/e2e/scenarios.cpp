@@ -1,0 +1,445 @@
+#include "scenarios.hpp"
+
+#include <time.h>
+
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fstream>
+#include <iostream>
+#include <regex>
+#include <stdexcept>
+#include <stop_token>
+#include <thread>
+
+#include "child_process.hpp"
+#include "latency_log.hpp"
+#include "process_usage.hpp"
+#include "rsg/udp_socket.hpp"
+#include "stamped_frames.hpp"
+#include "state_subscriber.hpp"
+
+namespace rsg::bench {
+namespace {
+
+using json = nlohmann::json;
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+
+constexpr std::array kTransports = {
+    Transport{"udp", "bench_udp", "bench_reader"},
+    Transport{"shm", "bench_shm", "bench_reader"},
+    Transport{"datasharing", "bench_shm", "bench_reader_datasharing"},
+};
+
+constexpr std::string_view kGatewayWriterProfile = "rsg_state_writer";  // xml_profiles/gateway.xml
+// The gateway's own default: 2 s of full frames at 1 kHz. The UDP baseline gets the same.
+constexpr int kReceiveBufferBytes = 4 << 20;
+// Generous: discovery and start-up on a 2-core machine shared with compilers can take seconds.
+constexpr auto kStartupTimeout = seconds(20);
+// After the last frame: how long stragglers (retransmissions, a descheduled reader) may take.
+constexpr auto kDrainTimeout = seconds(2);
+// A rate step counts only when the sender really kept the rate it claims.
+constexpr double kMinAchievedRateFraction = 0.95;
+
+/// Frame k of a run is due at start + k / rate. A late frame leaves at once, so the average rate
+/// holds when the sender is descheduled; latency starts at each frame's own stamp, so sending
+/// late is not counted as latency. Absolute deadlines on CLOCK_MONOTONIC, with the timer slack of
+/// the sending thread set to 1 ns in main(): the kernel's default 50 us slack would bunch frames.
+class Pacer {
+ public:
+  explicit Pacer(double rate_hz) : period_ns_(1e9 / rate_hz), start_ns_(monotonic_ns()) {}
+
+  void wait_for(std::uint64_t k) const {
+    const std::int64_t due = start_ns_ + std::llround(static_cast<double>(k) * period_ns_);
+    const timespec deadline{static_cast<time_t>(due / 1'000'000'000), static_cast<long>(due % 1'000'000'000)};
+    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
+    }
+  }
+
+ private:
+  double period_ns_;
+  std::int64_t start_ns_;
+};
+
+struct SendReport {
+  std::uint64_t sent = 0;
+  std::uint64_t failed = 0;
+  double seconds = 0;
+  double achieved_rate_hz() const { return seconds > 0 ? static_cast<double>(sent + failed) / seconds : 0; }
+};
+
+/// Sends frames [first, first + count) at `rate_hz` with `send(k)` (false: refused), calling
+/// `once_a_second()` between frames about once a second.
+template <typename Send, typename Tick>
+SendReport send_paced(std::uint64_t first, std::uint64_t count, double rate_hz, Send send,
+                      Tick once_a_second) {
+  const auto frames_per_second = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(rate_hz));
+  const Pacer pacer(rate_hz);
+  const auto start = Clock::now();
+  SendReport report;
+  for (std::uint64_t k = 0; k < count; ++k) {
+    pacer.wait_for(k);
+    ++(send(first + k) ? report.sent : report.failed);
+    if ((k + 1) % frames_per_second == 0) once_a_second();
+  }
+  report.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return report;
+}
+
+template <typename Send>
+SendReport send_paced(std::uint64_t first, std::uint64_t count, double rate_hz, Send send) {
+  return send_paced(first, count, rate_hz, send, [] {});
+}
+
+json to_json(const LatencySummary& summary) {
+  return {{"sent", summary.sent},     {"received", summary.received},
+          {"lost", summary.lost},     {"duplicates", summary.duplicates},
+          {"min_us", summary.min_us}, {"mean_us", summary.mean_us},
+          {"p50_us", summary.p50_us}, {"p90_us", summary.p90_us},
+          {"p99_us", summary.p99_us}, {"p99.9_us", summary.p999_us},
+          {"max_us", summary.max_us}};
+}
+
+/// What every latency scenario reports: its settings, the percentiles and, if asked, the CDF.
+json latency_result(const BenchOptions& options, const LatencyLog& log, const SendReport& sending) {
+  json result = to_json(log.summarize());
+  result["rate_hz"] = options.rate_hz;
+  result["achieved_rate_hz"] = sending.achieved_rate_hz();
+  result["send_failed"] = sending.failed;
+  result["duration_s"] = options.duration_s;
+  result["warmup_s"] = options.warmup_s;
+  if (!options.cdf_file.empty()) log.write_cdf(options.cdf_file);
+  return result;
+}
+
+std::string label_of(const Transport& transport, double rate_hz) {
+  return std::string(transport.name) + "_" + std::to_string(std::llround(rate_hz)) + "hz";
+}
+
+json read_json_file(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  return in ? json::parse(in, nullptr, /*allow_exceptions=*/false) : json();
+}
+
+/// rsg_gateway as a child process, on a port the kernel picked, logging to the scratch directory.
+class GatewayProcess {
+ public:
+  GatewayProcess(const BenchOptions& options, const Transport& transport, const std::string& topic,
+                 const std::string& label)
+      : log_(options.scratch_dir / ("gateway_" + label + ".log")),
+        stats_(options.scratch_dir / ("gateway_" + label + "_stats.json")),
+        process_({(options.bin_dir / "rsg_gateway").string(), "--listen", "127.0.0.1:0", "--domain",
+                  std::to_string(options.domain), "--topic", topic, "--status-topic", topic + "_status",
+                  "--profiles", options.profiles_dir.string(), "--participant-profile",
+                  std::string(transport.participant_profile), "--writer-profile",
+                  std::string(kGatewayWriterProfile), "--stats-file", stats_.string()},
+                 log_),
+        ingress_(wait_for_ingress()) {}
+
+  const Endpoint& ingress() const { return ingress_; }
+  pid_t pid() const { return process_.pid(); }
+
+  /// Stops it and returns the counters of its final stats file.
+  json stop() {
+    process_.stop();
+    return read_json_file(stats_);
+  }
+
+ private:
+  // The gateway logs where it listens ("ingress: frames on UDP 127.0.0.1:PORT -> ..."): with port
+  // 0 that is the only race-free way to learn the port.
+  Endpoint wait_for_ingress() {
+    constexpr std::string_view kMarker = "frames on UDP ";
+    const auto deadline = Clock::now() + kStartupTimeout;
+    while (Clock::now() < deadline) {
+      std::ifstream in(log_);
+      for (std::string line; std::getline(in, line);)
+        if (const auto at = line.find(kMarker); at != std::string::npos) {
+          const auto begin = at + kMarker.size();
+          return Endpoint::parse(std::string_view(line).substr(begin, line.find(' ', begin) - begin));
+        }
+      if (!process_.running())
+        throw std::runtime_error("rsg_gateway exited at start-up; see " + log_.string());
+      std::this_thread::sleep_for(milliseconds(20));
+    }
+    throw std::runtime_error("rsg_gateway did not report its UDP port; see " + log_.string());
+  }
+
+  std::filesystem::path log_;
+  std::filesystem::path stats_;
+  ChildProcess process_;
+  Endpoint ingress_;
+};
+
+json usage_json(const ProcessUsage& start, const ProcessUsage& from, const ProcessUsage& to) {
+  return {{"t_s", std::chrono::duration<double>(to.at - start.at).count()},
+          {"rss_kb", to.rss_kb},
+          {"cpu_percent", cpu_percent(from, to)}};
+}
+
+void require(bool condition, const std::string& what) {
+  if (!condition) throw std::runtime_error(what);
+}
+
+}  // namespace
+
+const Transport& transport_named(std::string_view name) {
+  for (const Transport& transport : kTransports)
+    if (transport.name == name) return transport;
+  throw std::invalid_argument("unknown transport '" + std::string(name) + "' (udp, shm, datasharing)");
+}
+
+std::uint64_t BenchOptions::warmup_frames() const {
+  return static_cast<std::uint64_t>(std::llround(warmup_s * rate_hz));
+}
+std::uint64_t BenchOptions::measured_frames() const {
+  return static_cast<std::uint64_t>(std::llround(duration_s * rate_hz));
+}
+
+json run_gateway(const BenchOptions& options, const Transport& transport) {
+  const std::string label = label_of(transport, options.rate_hz);
+  const std::string topic = options.topic + "_" + label;
+  GatewayProcess gateway(options, transport, topic, label);
+
+  Participant participant(options.domain, std::string(transport.participant_profile));
+  LatencyLog log(options.warmup_frames(), options.measured_frames());
+  StateSubscriber subscriber(participant, topic, std::string(transport.reader_profile), log);
+  require(subscriber.wait_for_writer(kStartupTimeout), "the gateway's writer never matched");
+
+  UdpSocket socket = UdpSocket::for_sending_to(gateway.ingress());
+  StampedFrames frames;
+  const auto send = [&](std::uint64_t k) {
+    frames.stamp_now(k);
+    return socket.send_to(frames.encode(), gateway.ingress());
+  };
+  send_paced(0, options.warmup_frames(), options.rate_hz, send);
+
+  // CPU and RSS from the end of warm-up, so start-up and discovery are not counted.
+  const ProcessUsage after_warmup = read_usage(gateway.pid());
+  json timeline = json::array();
+  ProcessUsage last_usage = after_warmup;
+  const auto usage_period = std::chrono::duration<double>(options.usage_period_s);
+  const SendReport sending =
+      send_paced(options.warmup_frames(), options.measured_frames(), options.rate_hz, send, [&] {
+        if (Clock::now() - last_usage.at < usage_period) return;
+        const ProcessUsage now = read_usage(gateway.pid());
+        timeline.push_back(usage_json(after_warmup, last_usage, now));
+        last_usage = now;
+      });
+  const ProcessUsage at_end = read_usage(gateway.pid());
+  timeline.push_back(usage_json(after_warmup, last_usage, at_end));
+
+  subscriber.wait_for_all(kDrainTimeout);
+  json result = latency_result(options, log, sending);
+  result["transport"] = transport.name;
+  result["data_sharing_used"] = maps_data_sharing_segment();
+  result["gateway"] = {{"cpu_percent", cpu_percent(after_warmup, at_end)},
+                       {"rss_kb_after_warmup", after_warmup.rss_kb},
+                       {"rss_kb_end", at_end.rss_kb},
+                       {"rss_growth_kb", at_end.rss_kb - after_warmup.rss_kb},
+                       {"timeline", std::move(timeline)},
+                       {"stats", gateway.stop()}};
+  return result;
+}
+
+json run_max_rate(const BenchOptions& options, const std::vector<double>& rates) {
+  json steps = json::array();
+  double best = 0;
+  for (const double rate : rates) {
+    BenchOptions step = options;
+    step.rate_hz = rate;
+    step.warmup_s = std::min(options.warmup_s, 1.0);
+    step.cdf_file.clear();
+    json run = run_gateway(step, transport_named("udp"));
+    const bool kept_rate = run["achieved_rate_hz"].get<double>() >= kMinAchievedRateFraction * rate;
+    const bool passed = kept_rate && run["lost"].get<std::uint64_t>() == 0;
+    std::cerr << "rsg_bench_e2e: max rate: " << rate << " Hz: " << run["lost"] << " lost, sender at "
+              << run["achieved_rate_hz"] << " Hz, gateway CPU " << run["gateway"]["cpu_percent"] << " %\n";
+    steps.push_back({{"rate_hz", rate},
+                     {"achieved_rate_hz", run["achieved_rate_hz"]},
+                     {"sent", run["sent"]},
+                     {"received", run["received"]},
+                     {"lost", run["lost"]},
+                     {"p50_us", run["p50_us"]},
+                     {"p99_us", run["p99_us"]},
+                     {"gateway_cpu_percent", run["gateway"]["cpu_percent"]},
+                     {"gateway_stats", run["gateway"]["stats"]},
+                     {"passed", passed},
+                     {"sender_kept_rate", kept_rate}});
+    if (!passed) break;
+    best = rate;
+  }
+  return {{"max_rate_zero_loss_hz", best}, {"step_duration_s", options.duration_s}, {"steps", steps}};
+}
+
+json run_udp_oneway(const BenchOptions& options) {
+  UdpSocket receiver = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
+  receiver.set_receive_buffer(kReceiveBufferBytes);
+  const Endpoint destination = receiver.local_endpoint();
+  LatencyLog log(options.warmup_frames(), options.measured_frames());
+
+  // Receives as the gateway does (poll, then recvfrom into a buffer allocated up front), stamps,
+  // and only then decodes to find the frame's own stamp.
+  std::jthread receiving([&](std::stop_token stop) {
+    std::vector<std::uint8_t> datagram(kMaxFrameBytes + 1);
+    while (!stop.stop_requested()) {
+      const auto size = receiver.receive(datagram, nullptr, milliseconds(100));
+      if (!size) continue;
+      const std::int64_t received_ns = monotonic_ns();
+      const DecodeResult decoded = decode(std::span(datagram).first(std::min(*size, datagram.size())));
+      if (!decoded) continue;
+      if (const auto stamp = read_stamp(decoded.frame())) log.record(*stamp, received_ns);
+    }
+  });
+
+  UdpSocket socket = UdpSocket::for_sending_to(destination);
+  StampedFrames frames;
+  const auto send = [&](std::uint64_t k) {
+    frames.stamp_now(k);
+    return socket.send_to(frames.encode(), destination);
+  };
+  send_paced(0, options.warmup_frames(), options.rate_hz, send);
+  const SendReport sending =
+      send_paced(options.warmup_frames(), options.measured_frames(), options.rate_hz, send);
+  const auto deadline = Clock::now() + kDrainTimeout;
+  while (log.arrived() < log.expected() && Clock::now() < deadline)
+    std::this_thread::sleep_for(milliseconds(10));
+  receiving.request_stop();
+  receiving.join();
+  return latency_result(options, log, sending);
+}
+
+json run_fastdds(const BenchOptions& options, const Transport& transport) {
+  const std::string label = label_of(transport, options.rate_hz);
+  const std::string topic = options.topic + "_plain_" + label;
+  Participant participant(options.domain, std::string(transport.participant_profile));
+  LatencyLog log(options.warmup_frames(), options.measured_frames());
+  StateSubscriber subscriber(participant, topic, std::string(transport.reader_profile), log);
+
+  const std::uint64_t frames = options.warmup_frames() + options.measured_frames();
+  const std::filesystem::path writer_log = options.scratch_dir / ("writer_" + label + ".log");
+  ChildProcess writer({(options.bin_dir / "rsg_bench_e2e").string(), "--role", "writer", "--transport",
+                       std::string(transport.name), "--domain", std::to_string(options.domain), "--topic",
+                       topic, "--rate", std::to_string(options.rate_hz), "--frames", std::to_string(frames),
+                       "--profiles", options.profiles_dir.string()},
+                      writer_log);
+  const auto run_time = std::chrono::duration<double>(static_cast<double>(frames) / options.rate_hz);
+  const auto exit_status = writer.wait_for(std::chrono::ceil<milliseconds>(run_time) + 2 * kStartupTimeout);
+  require(exit_status == 0, "the writer process failed or hung; see " + writer_log.string());
+
+  subscriber.wait_for_all(kDrainTimeout);
+  // The writer measured its own sending; here only its frame count is known, at the nominal rate.
+  SendReport sending{options.measured_frames(), 0, options.duration_s};
+  json result = latency_result(options, log, sending);
+  result.erase("achieved_rate_hz");
+  result["transport"] = transport.name;
+  result["data_sharing_used"] = maps_data_sharing_segment();
+  return result;
+}
+
+int run_writer_role(const BenchOptions& options, const Transport& transport, std::uint64_t frames) {
+  Participant participant(options.domain, std::string(transport.participant_profile));
+  fdds::DataWriter* writer = participant.publisher()->create_datawriter_with_profile(
+      participant.robot_state_topic(options.topic), std::string(kGatewayWriterProfile));
+  if (!writer) {
+    std::cerr << "rsg_bench_e2e writer: cannot create the writer\n";
+    return 1;
+  }
+  const auto deadline = Clock::now() + kStartupTimeout;
+  for (fdds::PublicationMatchedStatus matched; matched.current_count == 0;
+       writer->get_publication_matched_status(matched)) {
+    if (Clock::now() > deadline) {
+      std::cerr << "rsg_bench_e2e writer: no reader matched\n";
+      return 1;
+    }
+    std::this_thread::sleep_for(milliseconds(10));
+  }
+
+  // The gateway's publish path (Ingress::publish) minus the decode: loan, copy in, write.
+  StampedFrames stamped;
+  const SendReport sending = send_paced(0, frames, options.rate_hz, [&](std::uint64_t k) {
+    stamped.stamp_now(k);
+    void* loan = nullptr;
+    if (writer->loan_sample(loan,
+                            fdds::DataWriter::LoanInitializationKind::CONSTRUCTED_LOAN_INITIALIZATION) !=
+        ReturnCode_t::RETCODE_OK)
+      return false;
+    stamped.fill(*static_cast<RobotState*>(loan));
+    if (writer->write(loan)) return true;
+    writer->discard_loan(loan);
+    return false;
+  });
+  writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
+  std::cerr << "rsg_bench_e2e writer: " << sending.sent << " written, " << sending.failed << " refused, "
+            << sending.achieved_rate_hz() << " Hz\n";
+  return sending.failed == 0 ? 0 : 1;
+}
+
+json run_ddsperf(const BenchOptions& options) {
+  // ddsperf prints one line per second per peer:
+  //   [pid] 3.000  host:pid size 2137 mean 74.18us min 17.77us 50% 34.31us 90% 48.00us 99% 1439.18us
+  //   max 4273.38us cnt 938
+  // Percentiles of one second each: they cannot be merged exactly, so the result is their
+  // frame-weighted mean (max: the largest), halved for one way. Seconds of warm-up are skipped.
+  static const std::regex kInterval(
+      R"(\] ([\d.]+) +\S+ size (\d+) mean ([\d.]+)us min ([\d.]+)us 50% ([\d.]+)us 90% ([\d.]+)us )"
+      R"(99% ([\d.]+)us max ([\d.]+)us cnt (\d+))");
+  static const std::regex kTimeouts(R"(ping timed out \(total (\d+) times\))");
+  constexpr int kSampleBytes = 2137;
+
+  const std::string domain = std::to_string(options.domain);
+  const int ping_seconds = static_cast<int>(std::ceil(options.warmup_s + options.duration_s)) + 1;
+  const int pong_seconds = ping_seconds + 10;  // outlives ping's wait for discovery
+  const std::filesystem::path pong_log = options.scratch_dir / "ddsperf_pong.log";
+  const std::filesystem::path ping_log = options.scratch_dir / "ddsperf_ping.log";
+  ChildProcess pong({options.ddsperf.string(), "-i", domain, "-D", std::to_string(pong_seconds), "pong"},
+                    pong_log);
+  ChildProcess ping(
+      {options.ddsperf.string(), "-i", domain, "-Qminmatch:1", "-Qinitwait:20", "-D",
+       std::to_string(ping_seconds), "ping", std::to_string(std::llround(options.rate_hz)) + "Hz", "size",
+       std::to_string(kSampleBytes)},
+      ping_log);
+  const auto exit_status = ping.wait_for(seconds(ping_seconds) + 2 * kStartupTimeout);
+  require(exit_status.has_value(), "ddsperf ping hung; see " + ping_log.string());
+  pong.stop();
+
+  double weight = 0, p50 = 0, p90 = 0, p99 = 0, mean = 0, max = 0, min = INFINITY;
+  std::uint64_t timeouts = 0;
+  std::ifstream in(ping_log);
+  for (std::string line; std::getline(in, line);) {
+    std::smatch match;
+    if (std::regex_search(line, match, kTimeouts)) timeouts = std::stoull(match[1]);
+    if (!std::regex_search(line, match, kInterval) || std::stod(match[1]) <= options.warmup_s) continue;
+    const double count = std::stod(match[9]);
+    weight += count;
+    mean += count * std::stod(match[3]);
+    min = std::min(min, std::stod(match[4]));
+    p50 += count * std::stod(match[5]);
+    p90 += count * std::stod(match[6]);
+    p99 += count * std::stod(match[7]);
+    max = std::max(max, std::stod(match[8]));
+  }
+  require(weight > 0, "no round trips in " + ping_log.string());
+  const auto one_way = [&](double weighted_sum) { return weighted_sum / weight / 2; };
+  return {{"round_trips", static_cast<std::uint64_t>(weight)},
+          {"ping_timeouts", timeouts},
+          {"lost", timeouts},
+          {"rate_hz", options.rate_hz},
+          {"duration_s", options.duration_s},
+          {"sample_bytes", kSampleBytes},
+          {"min_us", min / 2},
+          {"mean_us", one_way(mean)},
+          {"p50_us", one_way(p50)},
+          {"p90_us", one_way(p90)},
+          {"p99_us", one_way(p99)},
+          {"max_us", max / 2},
+          {"method",
+           "half of ddsperf's round trip; per-second percentiles averaged, weighted by round trips "
+           "(not exact percentiles of the whole run)"},
+          {"ddsperf_exit_status", *exit_status}};
+}
+
+}  // namespace rsg::bench

@@ -1,0 +1,62 @@
+// The measurements of rsg_bench_e2e. Each returns its result as a JSON object (times in us) that
+// tests/bench/e2e_report.py merges into results.json.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace rsg::bench {
+
+/// How samples travel from writer to reader (see bench_profiles.xml).
+struct Transport {
+  std::string_view name;
+  std::string_view participant_profile;
+  std::string_view reader_profile;
+};
+/// udp, shm, datasharing; throws std::invalid_argument for another name.
+const Transport& transport_named(std::string_view name);
+
+struct BenchOptions {
+  double rate_hz = 1000;
+  double duration_s = 30;  ///< measured part of a run
+  double warmup_s = 2;     ///< sent first and not measured
+  int domain = 0;
+  std::string topic = "rsg_bench_state";
+  std::filesystem::path bin_dir;       ///< rsg_gateway and this binary
+  std::filesystem::path profiles_dir;  ///< every profile, the gateway's and the bench's (see Scratch)
+  std::filesystem::path scratch_dir;   ///< logs and stats files of the children
+  std::filesystem::path cdf_file;      ///< where to write the latency CDF; empty: nowhere
+  std::filesystem::path ddsperf = "/usr/bin/ddsperf";
+  double usage_period_s = 10;  ///< how often the soak samples the gateway's RSS and CPU
+
+  std::uint64_t warmup_frames() const;
+  std::uint64_t measured_frames() const;
+};
+
+/// Frames sent over UDP to a separate rsg_gateway, received as samples here. Also the gateway's
+/// CPU and RSS, after warm-up, at the end and every `usage_period_s` (a long run is the soak test).
+nlohmann::json run_gateway(const BenchOptions& options, const Transport& transport);
+
+/// Gateway runs of `duration_s` each at rising rates until one loses a frame or the sender
+/// cannot keep the rate; the highest rate without loss.
+nlohmann::json run_max_rate(const BenchOptions& options, const std::vector<double>& rates);
+
+/// Baseline: the same datagram over UDP loopback, one way.
+nlohmann::json run_udp_oneway(const BenchOptions& options);
+
+/// Baseline: the same samples from a plain Fast DDS writer in a child process (this binary in
+/// the writer role) to a reader here, with the gateway's writer QoS and no gateway.
+nlohmann::json run_fastdds(const BenchOptions& options, const Transport& transport);
+
+/// The writer role of `run_fastdds`: `frames` samples at `rate_hz` once a reader matched.
+/// Returns the process exit status.
+int run_writer_role(const BenchOptions& options, const Transport& transport, std::uint64_t frames);
+
+/// Peer reference: Cyclone DDS's ddsperf ping/pong of 2137-byte samples, half the round trip.
+nlohmann::json run_ddsperf(const BenchOptions& options);
+
+}  // namespace rsg::bench

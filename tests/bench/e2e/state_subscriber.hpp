@@ -1,0 +1,46 @@
+// The measuring end of the DDS scenarios: a RobotState reader that stamps each sample on arrival.
+//
+// Samples are taken in on_data_available, on the Fast DDS thread that delivered them (the
+// transport's receive thread, or data-sharing's listener), with loans: the receive time is read
+// before anything else, and a data-sharing reader reads the stamp in the writer's shared memory
+// without copying the sample.
+#pragma once
+
+#include <chrono>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <string>
+
+#include "latency_log.hpp"
+#include "rsg/participant.hpp"
+
+namespace rsg::bench {
+
+class StateSubscriber : private fdds::DataReaderListener {
+ public:
+  /// Creates the reader; `log` must outlive it. Throws std::runtime_error.
+  StateSubscriber(Participant& participant, const std::string& topic, const std::string& reader_profile,
+                  LatencyLog& log);
+  ~StateSubscriber() override;
+  StateSubscriber(const StateSubscriber&) = delete;
+  StateSubscriber& operator=(const StateSubscriber&) = delete;
+
+  /// Waits until a writer has matched; false on timeout.
+  bool wait_for_writer(std::chrono::milliseconds timeout) const;
+  /// Waits until `log` holds every frame or `timeout` passes; true when it holds every frame.
+  bool wait_for_all(std::chrono::milliseconds timeout) const;
+
+ private:
+  void on_data_available(fdds::DataReader* reader) override;
+
+  Participant& participant_;
+  LatencyLog& log_;
+  fdds::Subscriber* subscriber_ = nullptr;
+  fdds::DataReader* reader_ = nullptr;
+};
+
+/// True when this process has a Fast DDS data-sharing segment mapped: a data-sharing reader maps
+/// its writer's history (/dev/shm/fast_datasharing_*), a reader served by a transport never does.
+bool maps_data_sharing_segment();
+
+}  // namespace rsg::bench
