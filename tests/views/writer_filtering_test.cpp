@@ -127,7 +127,7 @@ TEST(WriterSideFiltering, WithoutReaderFilterSlotsTheWriterSendsEverything) {
   EXPECT_EQ(outcome.received, outcome.accepted) << "the reader must filter instead";
 }
 
-// rsg_gateway's rsg_state_writer has a 2 s liveliness lease, so it is in this case.
+// Why rsg_gateway's rsg_state_writer keeps the default, infinite liveliness.
 TEST(WriterSideFiltering, AWriterWithFiniteLivelinessSendsEverything) {
   fdds::DataWriterQos qos = fdds::DATAWRITER_QOS_DEFAULT;
   qos.liveliness().kind = fdds::AUTOMATIC_LIVELINESS_QOS;
@@ -136,6 +136,19 @@ TEST(WriterSideFiltering, AWriterWithFiniteLivelinessSendsEverything) {
   const Outcome outcome = publish_mixed_stream_to_a_view(qos, Delivery::kUdp);
   EXPECT_EQ(outcome.sent.size(), outcome.written);
   EXPECT_EQ(outcome.received, outcome.accepted) << "the reader must filter instead";
+}
+
+// The QoS the gateway really publishes with (xml_profiles/gateway.xml).
+TEST(WriterSideFiltering, TheGatewayWriterProfileKeepsRejectedSamplesOffTheWire) {
+  load_profiles(default_profiles_dir());
+  Participant any(static_cast<int>(::getpid() % 200 + 10), "");
+  fdds::DataWriterQos gateway_qos;
+  ASSERT_EQ(any.publisher()->get_datawriter_qos_from_profile("rsg_state_writer", gateway_qos),
+            ReturnCode_t::RETCODE_OK);
+  const Outcome outcome = publish_mixed_stream_to_a_view(gateway_qos, Delivery::kUdp);
+  ASSERT_LT(outcome.accepted.size(), outcome.written);
+  EXPECT_EQ(outcome.sent, outcome.accepted) << "the gateway's writer put rejected samples on the wire";
+  EXPECT_EQ(outcome.received, outcome.accepted);
 }
 
 // Data-sharing readers read the writer's history in shared memory: nothing goes through the
