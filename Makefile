@@ -27,8 +27,8 @@ build: deps
 
 # Unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer.
 unit-asan: deps
-	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DRSG_SANITIZE=ON -DRSG_UNIT_TESTS_ONLY=ON
-	cmake --build $(ASAN_BUILD) -j $(JOBS)
+	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DRSG_SANITIZE=ON
+	cmake --build $(ASAN_BUILD) -j $(JOBS) --target unit_tests
 	cd $(ASAN_BUILD) && ctest --output-on-failure -L unit
 
 fuzz-build: deps
