@@ -1,15 +1,24 @@
 #!/usr/bin/env bash
-# Runs the benchmark suites of a build, keeps each suite's Google Benchmark JSON in
-# BUILD_DIR/bench/<suite>.json and prints them as markdown tables (bench_table.py).
+# Runs the benchmark suites of a build into BUILD_DIR/bench/ and prints their tables.
 #
 #   tests/bench/run_bench.sh BUILD_DIR [SUITE...]      (default: every suite)
-#   BENCH_REPETITIONS=5    repetitions per benchmark; the tables show their median
 #
-# A suite is a function run_<suite> that writes $out/<suite>.json, plus its name in SUITES. The
-# end-to-end DDS benchmark goes in as a second suite next to `wire`.
+#   wire  the codec (rsg_bench_wire, Google Benchmark): bench/wire.json, tables by bench_table.py
+#         BENCH_REPETITIONS=5    repetitions per benchmark; the tables show their median
+#   e2e   frames through a running rsg_gateway to a DDS reader, and baselines (rsg_bench_e2e):
+#         bench/results.json, results.md, latency_cdf.png (e2e_report.py), raw runs in bench/e2e/.
+#         About 6 minutes: 30 s per latency run, 10 s per max-rate step, and the 5-minute RSS soak
+#         running alongside them.
+#         RSG_BENCH_FULL=1   120 s per latency run, 30 s per max-rate step, the soak on its own
+#                            afterwards (about 25 minutes, quieter numbers)
+#         RSG_BENCH_E2E_SECONDS, RSG_BENCH_E2E_STEP_SECONDS, RSG_BENCH_E2E_SOAK_SECONDS override
+#                            those durations (e.g. a quick try of the suite)
+#
+# A suite is a function run_<suite> that writes its results under $out and a function
+# report_<suite> that prints them, plus its name in SUITES.
 set -euo pipefail
 
-SUITES=(wire)
+SUITES=(wire e2e)
 
 here=$(cd "$(dirname "$0")" && pwd)
 usage() { echo "usage: $0 BUILD_DIR [${SUITES[*]}]" >&2; exit 2; }
@@ -31,13 +40,67 @@ run_wire() {
   # shellcheck disable=SC2046  # word splitting of the options is intended
   "$build/bin/rsg_bench_wire" $(gbench_options wire)
 }
+report_wire() { python3 "$here/bench_table.py" "$out/wire.json"; }
+
+# Latency runs in the order the report compares them: baselines next to the gateway they judge.
+e2e_soak_pid=
+E2E_LATENCY_SCENARIOS=(baseline_udp_oneway baseline_fastdds gateway_udp
+                       baseline_fastdds_shm gateway_shm
+                       baseline_fastdds_datasharing gateway_datasharing
+                       cyclone_ddsperf)
+
+run_e2e() {
+  local bench=$build/bin/rsg_bench_e2e runs=$out/e2e
+  local seconds=30 step_seconds=10 soak_seconds=300 soak_concurrent=true
+  if [[ ${RSG_BENCH_FULL:-0} == 1 ]]; then
+    seconds=120 step_seconds=30 soak_concurrent=false
+  fi
+  seconds=${RSG_BENCH_E2E_SECONDS:-$seconds}
+  step_seconds=${RSG_BENCH_E2E_STEP_SECONDS:-$step_seconds}
+  soak_seconds=${RSG_BENCH_E2E_SOAK_SECONDS:-$soak_seconds}
+  rm -rf "$runs" && mkdir -p "$runs"
+  local commit
+  commit=$(git -C "$here" describe --always --dirty 2>/dev/null || echo unknown)
+  printf '{"latency_run_s": %s, "max_rate_step_s": %s, "soak_s": %s, "soak_concurrent": %s, "full": %s, "commit": "%s"}\n' \
+    "$seconds" "$step_seconds" "$soak_seconds" "$soak_concurrent" "${RSG_BENCH_FULL:-0}" "$commit" >"$runs/settings.json"
+
+  # Each rsg_bench_e2e run stops its own children; the soak is ours to stop if we are stopped.
+  trap '[[ -n $e2e_soak_pid ]] && kill "$e2e_soak_pid" 2>/dev/null; fastdds shm clean >/dev/null 2>&1 || true' EXIT
+  local soak=("$bench" --scenario soak --duration "$soak_seconds" --out "$runs/soak.json")
+  # The 5-minute RSS soak is one more 1 kHz stream; by default it runs alongside the other runs
+  # (every run, baselines included, shares that load) so that the suite fits in 10 minutes.
+  if $soak_concurrent; then
+    echo "-- soak (${soak_seconds} s, in the background)"
+    "${soak[@]}" &
+    e2e_soak_pid=$!
+  fi
+  for scenario in "${E2E_LATENCY_SCENARIOS[@]}"; do
+    echo "-- $scenario (${seconds} s, load average $(cut -d' ' -f1-3 /proc/loadavg))"
+    "$bench" --scenario "$scenario" --duration "$seconds" --out "$runs/$scenario.json" --cdf "$runs/$scenario.cdf"
+  done
+  echo "-- max_rate (${step_seconds} s per step)"
+  "$bench" --scenario max_rate --duration "$step_seconds" --out "$runs/max_rate.json"
+  if $soak_concurrent; then
+    echo "-- waiting for the soak"
+    wait "$e2e_soak_pid"
+    e2e_soak_pid=
+  else
+    echo "-- soak (${soak_seconds} s)"
+    "${soak[@]}"
+  fi
+  fastdds shm clean >/dev/null 2>&1 || true
+  python3 "$here/e2e_report.py" "$runs" "$out" >/dev/null
+}
+report_e2e() { cat "$out/results.md"; }
 
 for suite in "${selected[@]}"; do
   declare -F "run_$suite" >/dev/null || { echo "$0: unknown suite '$suite'" >&2; usage; }
+done
+for suite in "${selected[@]}"; do
   echo "== $suite"
   "run_$suite"
 done
 echo
 for suite in "${selected[@]}"; do
-  python3 "$here/bench_table.py" "$out/$suite.json"
+  "report_$suite"
 done

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <array>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
@@ -106,6 +107,14 @@ int run_smoke(BenchOptions options) {
   return ok ? 0 : 1;
 }
 
+// The 1, 5 and 15 minute load averages: the record of how busy the shared machine was.
+json load_average() {
+  std::ifstream in("/proc/loadavg");
+  std::array<double, 3> averages{};
+  for (double& average : averages) in >> average;
+  return averages;
+}
+
 std::filesystem::path own_directory() {
   return std::filesystem::read_symlink("/proc/self/exe").parent_path();
 }
@@ -175,8 +184,10 @@ int main(int argc, char** argv) {
     rsg::load_profiles(options.profiles_dir);
     if (smoke) return run_smoke(options);
 
+    const json load_at_start = load_average();
     json result = scenarios(max_rate_steps).at(scenario)(options);
     result["scenario"] = scenario;
+    result["load_average"] = {{"start", load_at_start}, {"end", load_average()}};
     if (out.empty()) {
       std::cout << result.dump(2) << '\n';
     } else {
