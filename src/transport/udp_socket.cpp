@@ -5,6 +5,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -59,6 +60,30 @@ bool operator==(const Endpoint& a, const Endpoint& b) {
   return a.size_ == b.size_ && std::memcmp(&a.storage_, &b.storage_, a.size_) == 0;
 }
 
+DatagramBatch::DatagramBatch(std::size_t capacity, std::size_t buffer_bytes)
+    : buffer_bytes_(buffer_bytes),
+      storage_(capacity * buffer_bytes),
+      senders_(capacity),
+      slots_(capacity),
+      headers_(capacity) {
+  for (std::size_t i = 0; i < capacity; ++i) {
+    slots_[i] = {storage_.data() + i * buffer_bytes, buffer_bytes};
+    msghdr& header = headers_[i].msg_hdr;
+    header.msg_iov = &slots_[i];
+    header.msg_iovlen = 1;
+    header.msg_name = senders_[i].address();
+  }
+}
+
+DatagramBatch::Datagram DatagramBatch::operator[](std::size_t index) const {
+  const mmsghdr& header = headers_[index];
+  // With MSG_TRUNC in the receive flags msg_len is the real size; msg_flags says whether it was cut.
+  const bool truncated = (header.msg_hdr.msg_flags & MSG_TRUNC) != 0 || header.msg_len > buffer_bytes_;
+  const std::size_t kept = std::min<std::size_t>(header.msg_len, buffer_bytes_);
+  return {std::span(storage_).subspan(index * buffer_bytes_, kept), header.msg_len, truncated,
+          senders_[index]};
+}
+
 UdpSocket UdpSocket::bind(const Endpoint& local) {
   const int fd = ::socket(local.family(), SOCK_DGRAM | SOCK_CLOEXEC, 0);
   if (fd < 0) throw std::system_error(errno, std::generic_category(), "socket()");
@@ -93,8 +118,7 @@ UdpSocket::~UdpSocket() {
 
 std::optional<std::size_t> UdpSocket::receive(std::span<std::uint8_t> buffer, Endpoint* from,
                                               std::chrono::milliseconds timeout) {
-  pollfd waiting{fd_, POLLIN, 0};
-  if (::poll(&waiting, 1, static_cast<int>(timeout.count())) <= 0) return std::nullopt;
+  if (!wait_readable(timeout)) return std::nullopt;
   Endpoint ignored;
   Endpoint& source = from ? *from : ignored;
   socklen_t size = source.capacity();
@@ -103,6 +127,28 @@ std::optional<std::size_t> UdpSocket::receive(std::span<std::uint8_t> buffer, En
   if (received < 0) return std::nullopt;
   source.set_size(size);
   return static_cast<std::size_t>(received);
+}
+
+bool UdpSocket::wait_readable(std::chrono::milliseconds timeout) {
+  pollfd waiting{fd_, POLLIN, 0};
+  return ::poll(&waiting, 1, static_cast<int>(timeout.count())) > 0;
+}
+
+std::size_t UdpSocket::receive_batch(DatagramBatch& batch) {
+  batch.size_ = 0;
+  for (mmsghdr& header : batch.headers_) {
+    header.msg_hdr.msg_namelen = sizeof(sockaddr_storage);  // the kernel shrinks it to the sender's
+    header.msg_hdr.msg_flags = 0;
+  }
+  const int received = ::recvmmsg(fd_, batch.headers_.data(), static_cast<unsigned>(batch.headers_.size()),
+                                  MSG_DONTWAIT | MSG_TRUNC, nullptr);
+  // EAGAIN: nothing queued. Any other error is the socket's, not one datagram's: the caller's next
+  // wait reports it again or the socket recovers; either way there is nothing to hand out now.
+  if (received <= 0) return 0;
+  batch.size_ = static_cast<std::size_t>(received);
+  for (std::size_t i = 0; i < batch.size_; ++i)
+    batch.senders_[i].set_size(batch.headers_[i].msg_hdr.msg_namelen);
+  return batch.size_;
 }
 
 bool UdpSocket::send_to(std::span<const std::uint8_t> datagram, const Endpoint& to) {
