@@ -1,5 +1,6 @@
 #include "rsg/gateway/config.hpp"
 
+#include <sched.h>
 #include <yaml-cpp/yaml.h>
 
 #include <array>
@@ -108,6 +109,23 @@ const std::array kKeys = {
                 for (const char* level : kLevels)
                   if (c.log_level == level) return std::string();
                 return "'" + c.log_level + "' is not one of trace, debug, info, warn, error, off";
+              }},
+    ConfigKey{"rt-priority",
+              "Run the ingress thread SCHED_FIFO at this priority (1..99) and lock the process's memory "
+              "(mlockall); 0: off. Needs CAP_SYS_NICE or an rtprio limit, and CAP_IPC_LOCK or a memlock "
+              "limit; without them the gateway warns once and runs normally",
+              &GatewayConfig::rt_priority,
+              [](const GatewayConfig& c) {
+                return c.rt_priority >= 0 && c.rt_priority <= 99 ? std::string() : "must be in 0..99";
+              }},
+    ConfigKey{"cpu",
+              "Pin the ingress thread to this CPU (-1: off). Needs no privilege, only a CPU in the "
+              "process's cpuset; else a warning",
+              &GatewayConfig::cpu,
+              [](const GatewayConfig& c) {
+                return c.cpu >= -1 && c.cpu < CPU_SETSIZE
+                           ? std::string()
+                           : "must be -1 or 0.." + std::to_string(CPU_SETSIZE - 1);
               }},
     ConfigKey{"profiles", "Fast DDS XML profile file or directory (default: rsg's xml_profiles)",
               &GatewayConfig::profiles, [](const GatewayConfig&) { return std::string(); }},

@@ -130,7 +130,7 @@ void Gateway::run(const std::atomic<bool>& stop) {
     const auto wait =
         std::clamp(std::chrono::ceil<milliseconds>(wake - Clock::now()), milliseconds(0), kLongestWait);
     if (ingress_)
-      ingress_->receive_one(wait);
+      ingress_->receive(wait);
     else
       std::this_thread::sleep_for(wait);
 

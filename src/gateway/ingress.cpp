@@ -8,8 +8,6 @@
 namespace rsg::gateway {
 namespace {
 
-constexpr std::size_t kLargestDatagram = 65536;  // UDP payloads end at 65507 (IPv4) / 65527 (IPv6)
-
 std::optional<std::uint64_t> frame_time(const FrameView& frame) {
   const auto bytes = frame.field_bytes(Field::time);
   if (bytes.empty()) return std::nullopt;
@@ -25,7 +23,7 @@ Ingress::Ingress(Participant& participant, Options options)
     : options_(std::move(options)),
       socket_(UdpSocket::bind(options_.listen)),
       participant_(participant),
-      datagram_(kLargestDatagram),
+      batch_(kBatchDatagrams, kMaxFrameBytes),
       sequence_(options_.restart_threshold_ms),
       link_(options_.nominal_period) {
   if (options_.receive_buffer > 0) {
@@ -57,34 +55,55 @@ void Ingress::start(Clock::time_point now) {
   if (requester_ && options_.robot && requester_->start_up_due(now)) request_selection(*options_.robot, now);
 }
 
-void Ingress::receive_one(std::chrono::milliseconds timeout) {
-  if (const auto size = socket_.receive(datagram_, &sender_, timeout)) handle(*size, Clock::now());
+void Ingress::receive(std::chrono::milliseconds timeout) {
+  if (!socket_.wait_readable(timeout)) return;
+  for (std::size_t round = 0; round < kMaxBatchesPerWake; ++round) {
+    const std::size_t received = socket_.receive_batch(batch_);
+    // Every datagram of a batch was queued by now: one clock reading serves them all.
+    const auto now = Clock::now();
+    for (std::size_t i = 0; i < received; ++i) handle(batch_[i], now);
+    if (received < batch_.capacity()) return;  // the queue was empty; the next poll waits for more
+  }
 }
 
-void Ingress::handle(std::size_t size, Clock::time_point now) {
-  if (!options_.sources.allows(sender_.address())) {
+void Ingress::handle(const DatagramBatch::Datagram& datagram, Clock::time_point now) {
+  if (!options_.sources.allows(datagram.from.address())) {
     ++counters_.rejected_source;
-    last_foreign_sender_ = sender_;
+    last_foreign_sender_ = datagram.from;
     return;
   }
   ++counters_.received;
 
-  const DecodeResult decoded = decode(std::span(datagram_).first(std::min(size, datagram_.size())));
+  // Longer than any frame, so never valid; decoding the part that fit could pass it off as a
+  // valid frame of that length. Counted as the spec's length check counts such datagrams
+  // (length_mismatch); only a forged length field above kMaxDataBytes that matches the real size
+  // and fails the CRC would rank bad_crc first, and the cut-off bytes cannot tell.
+  if (datagram.truncated) {
+    reject({ErrorCategory::kLengthMismatch, "%zu bytes, longer than any frame (%zu)", datagram.size,
+            kMaxFrameBytes},
+           datagram.from);
+    return;
+  }
+  const DecodeResult decoded = decode(datagram.bytes);
   if (!decoded) {
-    ++counters_.invalid[invalid_index(decoded.error().category())];
-    last_rejection_ = decoded.error();
-    last_rejected_sender_ = sender_;
+    reject(decoded.error(), datagram.from);
     return;
   }
   const FrameView& frame = decoded.frame();
 
   sequence_.observe(frame.packet_number(), frame_time(frame));
   link_came_up_ |= link_.on_frame(now);
-  source_ = sender_;
+  source_ = datagram.from;
   if (requester_ && requester_->due(frame.selection(), now))
-    request_selection(options_.robot ? *options_.robot : sender_, now);
+    request_selection(options_.robot ? *options_.robot : datagram.from, now);
 
   publish(frame);
+}
+
+void Ingress::reject(const FrameError& error, const Endpoint& sender) {
+  ++counters_.invalid[invalid_index(error.category())];
+  last_rejection_ = error;
+  last_rejected_sender_ = sender;
 }
 
 void Ingress::publish(const FrameView& frame) {

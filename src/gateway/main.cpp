@@ -1,7 +1,8 @@
 // rsg_gateway: raw SEND_BUF frames over UDP <-> RobotState DDS samples. See gateway.hpp.
 //
 // Exit status: 0 after SIGINT/SIGTERM, 2 when the configuration (flags, file, profiles) is
-// unusable or the gateway cannot start; nothing has been created by then.
+// unusable or the gateway cannot start; nothing has been created by then. A refused real-time
+// setting (--rt-priority, --cpu) is a warning, not a failure.
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -14,12 +15,21 @@
 
 #include "gateway.hpp"
 #include "rsg/gateway/config.hpp"
+#include "rsg/gateway/realtime.hpp"
 
 namespace {
 
 using rsg::gateway::GatewayConfig;
 
 constexpr int kExitUsage = 2;
+
+constexpr const char* kRealtimeHelp = R"(Real-time mode applies to the ingress thread (the main thread):
+  --rt-priority N  SCHED_FIFO at N needs CAP_SYS_NICE or `USER - rtprio N` in
+                   /etc/security/limits.conf; the mlockall that comes with it needs CAP_IPC_LOCK
+                   or `USER - memlock unlimited`. Docker: --cap-add SYS_NICE --cap-add IPC_LOCK
+                   --ulimit rtprio=99 --ulimit memlock=-1
+  --cpu CPU        needs only a CPU of the process's cpuset (taskset, docker --cpuset-cpus).
+Whatever is refused is logged as one warning and the gateway runs without it.)";
 
 std::atomic<bool> stop_requested{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
@@ -67,6 +77,7 @@ std::optional<int> parse_command_line(int argc, char** argv, GatewayConfig& conf
   std::string config_file;
   {
     CLI::App app("rsg_gateway: robot-state frames over UDP <-> RobotState DDS samples", "rsg_gateway");
+    app.footer(kRealtimeHelp);
     GatewayConfig flags_only;
     add_config_flags(app, flags_only, config_file);
     try {
@@ -103,6 +114,23 @@ std::optional<int> parse_command_line(int argc, char** argv, GatewayConfig& conf
   return std::nullopt;
 }
 
+// Called once the Gateway exists: Fast DDS has created its threads by then, and they must not
+// inherit the ingress thread's priority and CPU.
+void enter_realtime_mode(const GatewayConfig& config) {
+  const rsg::gateway::RealtimeRequest request{config.rt_priority, config.cpu};
+  if (!request.any()) return;
+  const rsg::gateway::RealtimeOutcome outcome = rsg::gateway::enter_realtime(request);
+  if (!outcome.problems.empty()) {
+    spdlog::warn("real-time mode degraded, running without what was refused: {}", outcome.problems);
+    return;
+  }
+  std::string done;
+  if (outcome.fifo) done += "SCHED_FIFO priority " + std::to_string(request.priority) + ", memory locked";
+  if (outcome.pinned)
+    done += (done.empty() ? "" : ", ") + std::string("on CPU ") + std::to_string(request.cpu);
+  spdlog::info("real-time mode: ingress thread {}", done);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -123,6 +151,7 @@ int main(int argc, char** argv) {
   install_stop_handlers();
   try {
     rsg::gateway::Gateway gateway(setup);
+    enter_realtime_mode(config);
     gateway.run(stop_requested);
   } catch (const std::exception& error) {
     spdlog::error("cannot start: {}", error.what());

@@ -44,6 +44,10 @@ struct GatewayConfig {
   std::string stats_file;
   std::string log_level = "info";
 
+  // Real-time mode of the ingress thread (rsg/gateway/realtime.hpp: what each needs)
+  int rt_priority = 0;  ///< SCHED_FIFO priority 1..99, with mlockall; 0: off
+  int cpu = -1;         ///< pin the ingress thread to this CPU; -1: off
+
   // Fast DDS XML profiles
   std::string profiles;  ///< empty: rsg::default_profiles_dir()
   std::string participant_profile = "rsg_participant";

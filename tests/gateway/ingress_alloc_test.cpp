@@ -1,0 +1,267 @@
+// The gateway's own ingress loop allocates nothing in steady state: the real Ingress (UDP socket,
+// source filter, batch receive, decode, sequence tracker, link monitor, loaned write) over 10,000
+// frames after 1,000 of warm-up, counting every operator new made on this thread.
+// tests/unit/hot_path_alloc_test.cpp covers decode + write alone.
+//
+// Fast DDS 2.9.1's reliable writer (StatefulWriter, which the RELIABLE rsg_state_writer profile
+// gets) allocates on every write: it hands per-reader lambdas to for_matched_readers() as a
+// std::function taken by value, copied once per reader list, and the captures exceed the small
+// buffer (5 x 32 bytes in unsent_change_added_to_history, 5 x 24 in check_acked_status; later
+// Fast DDS releases take a template instead). So with the gateway's profile the test asserts that
+// every allocation is made by Fast DDS's own code, none by rsg's; with the same profile made
+// BEST_EFFORT (a StatelessWriter) it asserts that nothing at all is allocated.
+//
+// Replaces the global operator new, hence a binary of its own, outside the sanitizer build.
+#include <dlfcn.h>
+#include <execinfo.h>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdlib>
+#include <cstring>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+#include <filesystem>
+#include <new>
+#include <random>
+#include <thread>
+
+#include "ingress.hpp"
+#include "random_state.hpp"
+#include "rsg/frame.hpp"
+#include "rsg/profiles.hpp"
+
+namespace {
+
+// Only this thread counts: Fast DDS's own threads (discovery, timers, receive) are not the hot path.
+thread_local bool counting = false;
+thread_local std::size_t by_fast_dds = 0;
+thread_local std::size_t by_rsg = 0;
+thread_local std::array<void*, 32> first_rsg_trace{};  // printed when the test fails
+thread_local int first_rsg_trace_depth = 0;
+
+// The code that called operator new is the first frame outside this executable (operator new and
+// everything inlined into rsg's code live in it). When that is libfastrtps, Fast DDS allocated;
+// anything else (rsg's code, or libstdc++ called from it) counts against rsg.
+bool called_from_fast_dds(void* const* frames, int depth) {
+  Dl_info self{};
+  ::dladdr(reinterpret_cast<void*>(&called_from_fast_dds), &self);
+  for (int i = 0; i < depth; ++i) {
+    Dl_info frame{};
+    if (!::dladdr(frames[i], &frame)) return false;
+    if (frame.dli_fbase == self.dli_fbase) continue;
+    return frame.dli_fname && std::strstr(frame.dli_fname, "libfastrtps");
+  }
+  return false;
+}
+
+void count_allocation() {
+  if (!counting) return;
+  counting = false;  // backtrace() and dladdr() must not count themselves
+  std::array<void*, 32> frames;
+  const int depth = ::backtrace(frames.data(), static_cast<int>(frames.size()));
+  if (called_from_fast_dds(frames.data(), depth)) {
+    ++by_fast_dds;
+  } else if (by_rsg++ == 0) {
+    first_rsg_trace = frames;
+    first_rsg_trace_depth = depth;
+  }
+  counting = true;
+}
+
+}  // namespace
+
+void* operator new(std::size_t size) {
+  count_allocation();
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void* operator new(std::size_t size, std::align_val_t alignment) {
+  count_allocation();
+  const std::size_t a = static_cast<std::size_t>(alignment);
+  if (void* p = std::aligned_alloc(a, (size + a - 1) / a * a)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size, std::align_val_t alignment) { return operator new(size, alignment); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+
+namespace rsg::gateway {
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr std::size_t kWarmUp = 1'000;
+constexpr std::size_t kMeasured = 10'000;
+constexpr std::size_t kCorruptEvery = 50;  // rejections are part of the hot path too
+// What Fast DDS 2.9.1's StatefulWriter allocates per write with one matched reader (see above).
+constexpr std::size_t kStatefulWriterAllocationsPerWrite = 10;
+
+// rsg_state_writer (xml_profiles/gateway.xml) with one difference: BEST_EFFORT.
+constexpr std::string_view kBestEffortProfile = R"(<?xml version="1.0" encoding="UTF-8"?>
+<dds xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <profiles>
+    <data_writer profile_name="ingress_alloc_best_effort">
+      <topic><historyQos><kind>KEEP_LAST</kind><depth>100</depth></historyQos></topic>
+      <qos>
+        <reliability><kind>BEST_EFFORT</kind></reliability>
+        <durability><kind>TRANSIENT_LOCAL</kind></durability>
+        <deadline><period><sec>0</sec><nanosec>100000000</nanosec></period></deadline>
+        <data_sharing><kind>AUTOMATIC</kind></data_sharing>
+      </qos>
+      <historyMemoryPolicy>PREALLOCATED_WITH_REALLOC</historyMemoryPolicy>
+    </data_writer>
+  </profiles>
+</dds>)";
+
+// Full frames with the robot's `time` running on, as a robot streams them, every
+// kCorruptEvery-th with a bad CRC.
+std::vector<std::vector<std::uint8_t>> make_frames(std::size_t count) {
+  std::mt19937_64 rng(7);
+  std::vector<std::vector<std::uint8_t>> frames;
+  for (std::size_t i = 0; i < count; ++i) {
+    StateValues values = test::random_state(rng);
+    values.selection = Selection::all();
+    values.packet_number = static_cast<std::uint8_t>(i % kPacketNumberModulo);
+    values.set_integer(Field::time, i);
+    std::vector<std::uint8_t> frame(kMaxFrameBytes);
+    frame.resize(
+        encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), frame).size);
+    if (i % kCorruptEvery == kCorruptEvery - 1) frame.back() ^= 0xFF;
+    frames.push_back(std::move(frame));
+  }
+  return frames;
+}
+
+class IngressAllocation : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    // No intra-process shortcut: the writes must really reach the other participant.
+    eprosima::fastrtps::LibrarySettingsAttributes settings;
+    settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+    eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
+    load_profiles(std::filesystem::path(RSG_PROFILES_DIR) / "gateway.xml");
+    // UDP only: Fast DDS 2.9's SHM transport allocates per send, which would hide rsg's own.
+    load_profiles(std::filesystem::path(RSG_TEST_DATA_DIR) / "hot_path_profiles.xml");
+    ASSERT_EQ(eprosima::fastrtps::xmlparser::XMLProfileManager::loadXMLString(kBestEffortProfile.data(),
+                                                                              kBestEffortProfile.size()),
+              eprosima::fastrtps::xmlparser::XMLP_ret::XML_OK);
+  }
+
+  void SetUp() override {
+    by_fast_dds = 0;
+    by_rsg = 0;
+  }
+
+  static Ingress::Options options(const std::string& writer_profile) {
+    Ingress::Options options;
+    options.listen = Endpoint::parse("127.0.0.1:0");
+    options.receive_buffer = 4 << 20;
+    std::string error;
+    EXPECT_TRUE(options.sources.allow("127.0.0.0/8", error)) << error;  // a filter that is consulted
+    options.topic = "ingress_alloc";
+    options.writer_profile = writer_profile;
+    options.nominal_period = std::chrono::milliseconds(1);
+    options.restart_threshold_ms = 100;
+    return options;
+  }
+
+  // Streams kWarmUp + kMeasured frames (and now and then a datagram longer than any frame) into
+  // an Ingress writing with `writer_profile` to a `reliability` reader in another participant,
+  // data sharing off; counts the allocations of the measured part. Returns the final stats.
+  GatewayStats stream(const std::string& writer_profile, fdds::ReliabilityQosPolicyKind reliability) {
+    Ingress ingress(publishing_, options(writer_profile));
+    fdds::DataReaderQos reader_qos = fdds::DATAREADER_QOS_DEFAULT;
+    reader_qos.reliability().kind = reliability;
+    reader_qos.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    reader_qos.history().depth = 100;
+    reader_qos.data_sharing().off();  // a transport, not shared memory, carries the samples
+    fdds::DataReader* reader = subscribing_.subscriber()->create_datareader(
+        subscribing_.robot_state_topic("ingress_alloc"), reader_qos);
+    EXPECT_NE(reader, nullptr);
+    const auto stats = [&] {
+      GatewayStats now;
+      ingress.fill(now);  // once a second in the gateway, and allowed to allocate: not counted
+      return now;
+    };
+    for (int i = 0; i < 500 && stats().state_readers == 0; ++i) std::this_thread::sleep_for(10ms);
+    EXPECT_EQ(stats().state_readers, 1U) << "the reader never matched";
+
+    UdpSocket robot = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
+    const Endpoint gateway = ingress.local_endpoint();
+    const std::array<std::uint8_t, kMaxFrameBytes + 100> oversize{};
+    const auto frames = make_frames(kWarmUp + kMeasured);
+    std::mt19937 burst_sizes(11);
+    std::size_t received = 0;
+    // Bursts of 1..45 frames, so that batches come full, partial and spread over several
+    // recvmmsg; the gateway's loop (receive, then ask the link monitor) handles each.
+    for (std::size_t next = 0; next < frames.size();) {
+      const std::size_t burst = std::min<std::size_t>(1 + burst_sizes() % 45, frames.size() - next);
+      for (std::size_t i = 0; i < burst; ++i) EXPECT_TRUE(robot.send_to(frames[next++], gateway));
+      received += burst;
+      if (next % 1000 < burst) {
+        EXPECT_TRUE(robot.send_to(oversize, gateway));
+        ++received;
+      }
+      const bool measured = next > kWarmUp;
+      do {
+        counting = measured;
+        ingress.receive(10ms);
+        ingress.link_changed(Clock::now());
+        counting = false;
+      } while (stats().ingress.received < received);
+    }
+
+    const GatewayStats final_stats = stats();
+    EXPECT_EQ(final_stats.ingress.received, received);
+    const std::uint64_t corrupted = frames.size() / kCorruptEvery;
+    EXPECT_EQ(final_stats.ingress.invalid[invalid_index(ErrorCategory::kBadCrc)], corrupted);
+    EXPECT_EQ(final_stats.ingress.invalid[invalid_index(ErrorCategory::kLengthMismatch)],
+              received - frames.size());
+    EXPECT_EQ(final_stats.ingress.published, frames.size() - corrupted);
+    EXPECT_TRUE(final_stats.link_up);
+
+    RobotState sample;
+    fdds::SampleInfo info;
+    EXPECT_EQ(reader->take_next_sample(&sample, &info), ReturnCode_t::RETCODE_OK)
+        << "nothing reached the reader";
+    subscribing_.subscriber()->delete_datareader(reader);
+    return final_stats;
+  }
+
+  static void expect_none_by_rsg() {
+    EXPECT_EQ(by_rsg, 0U) << "heap allocations by rsg on the ingress thread over " << kMeasured
+                          << " frames; the first one from:";
+    if (by_rsg) ::backtrace_symbols_fd(first_rsg_trace.data(), first_rsg_trace_depth, STDERR_FILENO);
+  }
+
+  const int domain_ = static_cast<int>(::getpid() % 200 + 10);
+  Participant publishing_{domain_, "rsg_hot_path_udp"};
+  Participant subscribing_{domain_, "rsg_hot_path_udp"};
+};
+
+TEST_F(IngressAllocation, WithTheGatewayProfileOnlyFastDdsReliableWriterAllocates) {
+  stream("rsg_state_writer", fdds::RELIABLE_RELIABILITY_QOS);
+  expect_none_by_rsg();
+  EXPECT_LE(by_fast_dds, kMeasured * kStatefulWriterAllocationsPerWrite)
+      << "Fast DDS allocates more per reliable write than 2.9.1 does";
+  std::printf("Fast DDS's reliable writer: %zu allocations over %zu frames\n", by_fast_dds, kMeasured);
+}
+
+TEST_F(IngressAllocation, WithABestEffortWriterNothingAllocates) {
+  stream("ingress_alloc_best_effort", fdds::BEST_EFFORT_RELIABILITY_QOS);
+  expect_none_by_rsg();
+  EXPECT_EQ(by_fast_dds, 0U) << "Fast DDS allocated on the ingress thread";
+}
+
+}  // namespace
+}  // namespace rsg::gateway
