@@ -115,6 +115,16 @@ json load_average() {
   return averages;
 }
 
+void write_result(const json& result, const std::string& file_name) {
+  if (file_name.empty()) {
+    std::cout << result.dump(2) << '\n';
+    return;
+  }
+  std::ofstream file(file_name);
+  file << result.dump(2) << '\n';
+  if (!file) throw std::runtime_error(file_name + ": cannot write");
+}
+
 std::filesystem::path own_directory() {
   return std::filesystem::read_symlink("/proc/self/exe").parent_path();
 }
@@ -129,7 +139,6 @@ int main(int argc, char** argv) {
   std::filesystem::path bench_profiles = RSG_BENCH_PROFILES;
   std::string scenario, role, transport = "udp", out;
   std::vector<double> max_rate_steps = {1000, 2000, 5000, 10000, 20000, 50000, 100000};
-  std::uint64_t frames = 0;
   bool smoke = false, keep_scratch = false;
 
   CLI::App app("rsg_bench_e2e: end-to-end latency of rsg_gateway and its baselines", "rsg_bench_e2e");
@@ -146,6 +155,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--out", out, "Write the result JSON here (default: stdout)");
   app.add_option("--cdf", options.cdf_file, "Write the latency CDF here (latency_us fraction)");
+  app.add_option("--writer-profile", options.writer_profile, "Writer QoS of the gateway and the DDS baseline")
+      ->capture_default_str();
   app.add_option("--domain", options.domain, "DDS domain")->capture_default_str();
   app.add_option("--profiles", options.profiles_dir, "The project's XML profiles (file or directory)");
   app.add_option("--bench-profiles", bench_profiles, "The bench's transport profiles")->capture_default_str();
@@ -155,7 +166,6 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"writer"}));
   app.add_option("--transport", transport, "(writer role) udp, shm or datasharing");
   app.add_option("--topic", options.topic, "(writer role) topic name");
-  app.add_option("--frames", frames, "(writer role) samples to write");
   CLI11_PARSE(app, argc, argv);
 
   // The sender paces with absolute sleeps on this (the main) thread: without the kernel's default
@@ -165,7 +175,11 @@ int main(int argc, char** argv) {
   if (role == "writer") {
     try {
       rsg::load_profiles(options.profiles_dir);
-      return rsg::bench::run_writer_role(options, transport_named(transport), frames);
+      const json result = rsg::bench::run_writer_role(options, transport_named(transport));
+      if (result["send_failed"].get<std::uint64_t>() != 0)
+        throw std::runtime_error("the writer refused samples");
+      write_result(result, out);
+      return 0;
     } catch (const std::exception& error) {
       std::cerr << "rsg_bench_e2e writer: " << error.what() << '\n';
       return 1;
@@ -188,13 +202,7 @@ int main(int argc, char** argv) {
     json result = scenarios(max_rate_steps).at(scenario)(options);
     result["scenario"] = scenario;
     result["load_average"] = {{"start", load_at_start}, {"end", load_average()}};
-    if (out.empty()) {
-      std::cout << result.dump(2) << '\n';
-    } else {
-      std::ofstream file(out);
-      file << result.dump(2) << '\n';
-      if (!file) throw std::runtime_error(out + ": cannot write");
-    }
+    write_result(result, out);
     return 0;
   } catch (const std::exception& error) {
     scratch.keep();

@@ -1,6 +1,7 @@
 #include "scenarios.hpp"
 
 #include <time.h>
+#include <unistd.h>
 
 #include <array>
 #include <cerrno>
@@ -34,7 +35,6 @@ constexpr std::array kTransports = {
     Transport{"datasharing", "bench_shm", "bench_reader_datasharing"},
 };
 
-constexpr std::string_view kGatewayWriterProfile = "rsg_state_writer";  // xml_profiles/gateway.xml
 // The gateway's own default: 2 s of full frames at 1 kHz. The UDP baseline gets the same.
 constexpr int kReceiveBufferBytes = 4 << 20;
 // Generous: discovery and start-up on a 2-core machine shared with compilers can take seconds.
@@ -111,6 +111,7 @@ json latency_result(const BenchOptions& options, const LatencyLog& log, const Se
   result["send_failed"] = sending.failed;
   result["duration_s"] = options.duration_s;
   result["warmup_s"] = options.warmup_s;
+  result["writer_profile"] = options.writer_profile;
   if (!options.cdf_file.empty()) log.write_cdf(options.cdf_file);
   return result;
 }
@@ -134,8 +135,8 @@ class GatewayProcess {
         process_({(options.bin_dir / "rsg_gateway").string(), "--listen", "127.0.0.1:0", "--domain",
                   std::to_string(options.domain), "--topic", topic, "--status-topic", topic + "_status",
                   "--profiles", options.profiles_dir.string(), "--participant-profile",
-                  std::string(transport.participant_profile), "--writer-profile",
-                  std::string(kGatewayWriterProfile), "--stats-file", stats_.string()},
+                  std::string(transport.participant_profile), "--writer-profile", options.writer_profile,
+                  "--stats-file", stats_.string()},
                  log_),
         ingress_(wait_for_ingress()) {}
 
@@ -319,48 +320,60 @@ json run_fastdds(const BenchOptions& options, const Transport& transport) {
   LatencyLog log(options.warmup_frames(), options.measured_frames());
   StateSubscriber subscriber(participant, topic, std::string(transport.reader_profile), log);
 
-  const std::uint64_t frames = options.warmup_frames() + options.measured_frames();
   const std::filesystem::path writer_log = options.scratch_dir / ("writer_" + label + ".log");
-  ChildProcess writer({(options.bin_dir / "rsg_bench_e2e").string(), "--role", "writer", "--transport",
-                       std::string(transport.name), "--domain", std::to_string(options.domain), "--topic",
-                       topic, "--rate", std::to_string(options.rate_hz), "--frames", std::to_string(frames),
-                       "--profiles", options.profiles_dir.string()},
+  const std::filesystem::path writer_result = options.scratch_dir / ("writer_" + label + ".json");
+  ChildProcess writer({(options.bin_dir / "rsg_bench_e2e").string(),
+                       "--role",
+                       "writer",
+                       "--transport",
+                       std::string(transport.name),
+                       "--domain",
+                       std::to_string(options.domain),
+                       "--topic",
+                       topic,
+                       "--rate",
+                       std::to_string(options.rate_hz),
+                       "--warmup",
+                       std::to_string(options.warmup_s),
+                       "--duration",
+                       std::to_string(options.duration_s),
+                       "--profiles",
+                       options.profiles_dir.string(),
+                       "--writer-profile",
+                       options.writer_profile,
+                       "--out",
+                       writer_result.string()},
                       writer_log);
-  const auto run_time = std::chrono::duration<double>(static_cast<double>(frames) / options.rate_hz);
+  const auto run_time = std::chrono::duration<double>(options.warmup_s + options.duration_s);
   const auto exit_status = writer.wait_for(std::chrono::ceil<milliseconds>(run_time) + 2 * kStartupTimeout);
   require(exit_status == 0, "the writer process failed or hung; see " + writer_log.string());
+  const json written = read_json_file(writer_result);
+  require(written.is_object(), "the writer process left no result in " + writer_result.string());
 
   subscriber.wait_for_all(kDrainTimeout);
-  // The writer measured its own sending; here only its frame count is known, at the nominal rate.
-  SendReport sending{options.measured_frames(), 0, options.duration_s};
+  const SendReport sending{written["sent"], written["send_failed"], written["seconds"]};
   json result = latency_result(options, log, sending);
-  result.erase("achieved_rate_hz");
   result["transport"] = transport.name;
   result["data_sharing_used"] = maps_data_sharing_segment();
+  result["writer_cpu_percent"] = written["cpu_percent"];
   return result;
 }
 
-int run_writer_role(const BenchOptions& options, const Transport& transport, std::uint64_t frames) {
+json run_writer_role(const BenchOptions& options, const Transport& transport) {
   Participant participant(options.domain, std::string(transport.participant_profile));
   fdds::DataWriter* writer = participant.publisher()->create_datawriter_with_profile(
-      participant.robot_state_topic(options.topic), std::string(kGatewayWriterProfile));
-  if (!writer) {
-    std::cerr << "rsg_bench_e2e writer: cannot create the writer\n";
-    return 1;
-  }
+      participant.robot_state_topic(options.topic), options.writer_profile);
+  require(writer != nullptr, "cannot create a writer with profile '" + options.writer_profile + "'");
   const auto deadline = Clock::now() + kStartupTimeout;
   for (fdds::PublicationMatchedStatus matched; matched.current_count == 0;
        writer->get_publication_matched_status(matched)) {
-    if (Clock::now() > deadline) {
-      std::cerr << "rsg_bench_e2e writer: no reader matched\n";
-      return 1;
-    }
+    require(Clock::now() < deadline, "no reader matched");
     std::this_thread::sleep_for(milliseconds(10));
   }
 
   // The gateway's publish path (Ingress::publish) minus the decode: loan, copy in, write.
   StampedFrames stamped;
-  const SendReport sending = send_paced(0, frames, options.rate_hz, [&](std::uint64_t k) {
+  const auto write = [&](std::uint64_t k) {
     stamped.stamp_now(k);
     void* loan = nullptr;
     if (writer->loan_sample(loan,
@@ -371,11 +384,18 @@ int run_writer_role(const BenchOptions& options, const Transport& transport, std
     if (writer->write(loan)) return true;
     writer->discard_loan(loan);
     return false;
-  });
+  };
+  send_paced(0, options.warmup_frames(), options.rate_hz, write);
+  // This process's CPU over the measured frames: what the gateway's CPU compares with.
+  const ProcessUsage before = read_usage(::getpid());
+  const SendReport sending =
+      send_paced(options.warmup_frames(), options.measured_frames(), options.rate_hz, write);
+  const ProcessUsage after = read_usage(::getpid());
   writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
-  std::cerr << "rsg_bench_e2e writer: " << sending.sent << " written, " << sending.failed << " refused, "
-            << sending.achieved_rate_hz() << " Hz\n";
-  return sending.failed == 0 ? 0 : 1;
+  return {{"sent", sending.sent},
+          {"send_failed", sending.failed},
+          {"seconds", sending.seconds},
+          {"cpu_percent", cpu_percent(before, after)}};
 }
 
 json run_ddsperf(const BenchOptions& options) {

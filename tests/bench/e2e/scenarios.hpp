@@ -26,6 +26,9 @@ struct BenchOptions {
   double warmup_s = 2;     ///< sent first and not measured
   int domain = 0;
   std::string topic = "rsg_bench_state";
+  /// The gateway's writer QoS (xml_profiles/gateway.xml); the plain DDS baseline uses it too.
+  /// Another profile (bench_profiles.xml has some) is for experiments.
+  std::string writer_profile = "rsg_state_writer";
   std::filesystem::path bin_dir;       ///< rsg_gateway and this binary
   std::filesystem::path profiles_dir;  ///< every profile, the gateway's and the bench's (see Scratch)
   std::filesystem::path scratch_dir;   ///< logs and stats files of the children
@@ -52,9 +55,9 @@ nlohmann::json run_udp_oneway(const BenchOptions& options);
 /// the writer role) to a reader here, with the gateway's writer QoS and no gateway.
 nlohmann::json run_fastdds(const BenchOptions& options, const Transport& transport);
 
-/// The writer role of `run_fastdds`: `frames` samples at `rate_hz` once a reader matched.
-/// Returns the process exit status.
-int run_writer_role(const BenchOptions& options, const Transport& transport, std::uint64_t frames);
+/// The writer role of `run_fastdds`: warm-up and measured samples at `rate_hz` once a reader
+/// matched; what it sent and its own CPU over the measured samples.
+nlohmann::json run_writer_role(const BenchOptions& options, const Transport& transport);
 
 /// Peer reference: Cyclone DDS's ddsperf ping/pong of 2137-byte samples, half the round trip.
 nlohmann::json run_ddsperf(const BenchOptions& options);
