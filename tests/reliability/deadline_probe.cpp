@@ -2,7 +2,7 @@
 // Test helper, not a product.
 //
 // Reads the RobotState topic with the `reader_realtime` profile (best effort, 100 ms requested
-// deadline) and the gateway's status topic, and prints one line per event:
+// deadline; --qos another) and the gateway's status topic, and prints one line per event:
 //   {"t":12.345678,"event":"sample","packet_number":3,"time":1042}
 //   {"t":12.445901,"event":"deadline_missed","total_count":1}
 //   {"t":12.446020,"event":"status","link_up":false,"lost":0,...}   (the --stats-file form)
@@ -127,12 +127,14 @@ int main(int argc, char** argv) {
   int domain = 0;
   std::string state_topic = "robot_state";
   std::string status_topic = "rsg_gateway_status";
+  std::string qos_profile = rsg::kRealtimeReaderProfile;
   double timeout_s = 30;
   CLI::App app("Prints RobotState arrivals, deadline misses and GatewayStatus as timestamped JSON lines",
                "rsg_deadline_probe");
   app.add_option("--domain", domain);
   app.add_option("--topic", state_topic);
   app.add_option("--status-topic", status_topic);
+  app.add_option("--qos", qos_profile, "RobotState reader profile")->capture_default_str();
   app.add_option("--timeout", timeout_s, "Seconds to run (SIGTERM ends it earlier)");
   CLI11_PARSE(app, argc, argv);
   std::signal(SIGTERM, [](int) { g_stop = 1; });
@@ -147,8 +149,7 @@ int main(int argc, char** argv) {
   fdds::Topic* states = participant.robot_state_topic(state_topic);
   const ReaderGuard state_reader{
       subscriber,
-      subscriber->create_datareader(states, rsg::load_reader_qos(*subscriber, rsg::kRealtimeReaderProfile),
-                                    &state_listener)};
+      subscriber->create_datareader(states, rsg::load_reader_qos(*subscriber, qos_profile), &state_listener)};
   fdds::Topic* statuses =
       participant.topic(status_topic, fdds::TypeSupport(new rsg::GatewayStatusPubSubType()));
   const ReaderGuard status_reader{subscriber, subscriber->create_datareader_with_profile(
