@@ -157,6 +157,8 @@ int main(int argc, char** argv) {
   app.add_option("--cdf", options.cdf_file, "Write the latency CDF here (latency_us fraction)");
   app.add_option("--writer-profile", options.writer_profile, "Writer QoS of the gateway and the DDS baseline")
       ->capture_default_str();
+  app.add_option("--reader-profile", options.reader_profile,
+                 "Reader QoS instead of the transport's (experiments)");
   app.add_option("--domain", options.domain, "DDS domain")->capture_default_str();
   app.add_option("--profiles", options.profiles_dir, "The project's XML profiles (file or directory)");
   app.add_option("--bench-profiles", bench_profiles, "The bench's transport profiles")->capture_default_str();

@@ -112,6 +112,7 @@ json latency_result(const BenchOptions& options, const LatencyLog& log, const Se
   result["duration_s"] = options.duration_s;
   result["warmup_s"] = options.warmup_s;
   result["writer_profile"] = options.writer_profile;
+  if (!options.reader_profile.empty()) result["reader_profile"] = options.reader_profile;
   if (!options.cdf_file.empty()) log.write_cdf(options.cdf_file);
   return result;
 }
@@ -207,7 +208,7 @@ json run_gateway(const BenchOptions& options, const Transport& transport) {
 
   Participant participant(options.domain, std::string(transport.participant_profile));
   LatencyLog log(options.warmup_frames(), options.measured_frames());
-  StateSubscriber subscriber(participant, topic, std::string(transport.reader_profile), log);
+  StateSubscriber subscriber(participant, topic, options.reader_profile_for(transport), log);
   require(subscriber.wait_for_writer(kStartupTimeout), "the gateway's writer never matched");
 
   UdpSocket socket = UdpSocket::for_sending_to(gateway.ingress());
@@ -318,7 +319,7 @@ json run_fastdds(const BenchOptions& options, const Transport& transport) {
   const std::string topic = options.topic + "_plain_" + label;
   Participant participant(options.domain, std::string(transport.participant_profile));
   LatencyLog log(options.warmup_frames(), options.measured_frames());
-  StateSubscriber subscriber(participant, topic, std::string(transport.reader_profile), log);
+  StateSubscriber subscriber(participant, topic, options.reader_profile_for(transport), log);
 
   const std::filesystem::path writer_log = options.scratch_dir / ("writer_" + label + ".log");
   const std::filesystem::path writer_result = options.scratch_dir / ("writer_" + label + ".json");

@@ -29,6 +29,12 @@ struct BenchOptions {
   /// The gateway's writer QoS (xml_profiles/gateway.xml); the plain DDS baseline uses it too.
   /// Another profile (bench_profiles.xml has some) is for experiments.
   std::string writer_profile = "rsg_state_writer";
+  /// Replaces the transport's reader profile (experiments); empty: the transport's.
+  std::string reader_profile;
+
+  std::string reader_profile_for(const Transport& transport) const {
+    return reader_profile.empty() ? std::string(transport.reader_profile) : reader_profile;
+  }
   std::filesystem::path bin_dir;       ///< rsg_gateway and this binary
   std::filesystem::path profiles_dir;  ///< every profile, the gateway's and the bench's (see Scratch)
   std::filesystem::path scratch_dir;   ///< logs and stats files of the children
