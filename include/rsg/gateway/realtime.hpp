@@ -7,7 +7,9 @@
 //                     docker run --cap-add SYS_NICE --ulimit rtprio=99).
 //                     It also asks for mlockall(MCL_CURRENT | MCL_FUTURE): CAP_IPC_LOCK, or an
 //                     RLIMIT_MEMLOCK above the process's size (limits.conf: `robot - memlock
-//                     unlimited`; docker run --cap-add IPC_LOCK or --ulimit memlock=-1).
+//                     unlimited`; docker run --cap-add IPC_LOCK or --ulimit memlock=-1). Prefer
+//                     unlimited: MCL_FUTURE locks later mappings too, and past a finite limit
+//                     they fail.
 //   --cpu CPU         pthread_setaffinity_np: no privilege, only a CPU the process may run on
 //                     (its cpuset: taskset, systemd CPUAffinity=, docker --cpuset-cpus).
 //
