@@ -161,8 +161,8 @@ def markdown(results):
         "and analysis in [e2e.md](e2e.md). One-way latency in µs, full 2137-byte frames at 1 kHz, same "
         "frames and same writer QoS (`rsg_state_writer`) everywhere.",
         "",
-        "| path | frames | lost | p50 | p90 | p99 | p99.9 | max | load avg (1 min) |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| path | frames | lost | p50 | p90 | p99 | p99.9 | max | publisher CPU | load avg (1 min) |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for name, title in LATENCY_ROWS:
         run = results.get(name)
@@ -170,11 +170,14 @@ def markdown(results):
             continue
         frames = run.get("received", run.get("round_trips"))
         load = (run.get("load_average") or {}).get("start", [None])[0]
+        cpu = run.get("gateway", {}).get("cpu_percent", run.get("writer_cpu_percent"))
         lines.append(f"| {title} | {fmt(frames)} | {fmt(run.get('lost'))} | {fmt(run['p50_us'])} | "
                      f"{fmt(run['p90_us'])} | {fmt(run['p99_us'])} | {fmt(run.get('p99.9_us'))} | "
-                     f"{fmt(run['max_us'])} | {fmt(load, 2)} |")
-    lines += ["", "ddsperf reports percentiles per second; its row is their round-trip-weighted mean, halved "
-              "(no p99.9). Its \"lost\" counts ping timeouts.", "", "## Goals", "",
+                     f"{fmt(run['max_us'])} | {fmt(cpu) + ' %' if cpu is not None else '–'} | {fmt(load, 2)} |")
+    lines += ["", "Publisher CPU: the rsg_gateway process (gateway rows) or the plain writer process (Fast DDS "
+              "rows), all threads, as % of one core over the measured part. ddsperf reports percentiles per "
+              "second; its row is their round-trip-weighted mean, halved (no p99.9). Its \"lost\" counts ping "
+              "timeouts.", "", "## Goals", "",
               "| goal | measured | limit | result | detail |", "|---|---:|---:|:---:|---|"]
     for g in results["goals"]:
         lines.append(f"| {g['goal']} | {fmt(float(g['value']))} | {fmt(float(g['limit']))} | "
@@ -216,8 +219,14 @@ def plot(run_dir, out_dir):
               if (run_dir / f"{name}.cdf").exists()]
     if not curves:
         return
-    cdf = ", ".join(f"'{path}' using 1:2 with lines lw 2 title '{title}'" for path, title in curves)
-    tail = ", ".join(f"'{path}' using 1:(1-$2) with lines lw 2 notitle" for path, _ in curves)
+    # A gateway and its baseline share a colour; the baseline is dashed.
+    styles = {"baseline_udp_oneway": "lc 1 dt 3", "baseline_fastdds": "lc 2 dt 2", "gateway_udp": "lc 2 dt 1",
+              "baseline_fastdds_shm": "lc 3 dt 2", "gateway_shm": "lc 3 dt 1",
+              "baseline_fastdds_datasharing": "lc 4 dt 2", "gateway_datasharing": "lc 4 dt 1"}
+    cdf = ", ".join(f"'{path}' using 1:2 with lines lw 2 {styles.get(path.stem, '')} title '{title}'"
+                    for path, title in curves)
+    tail = ", ".join(f"'{path}' using 1:(1-$2) with lines lw 2 {styles.get(path.stem, '')} notitle"
+                     for path, _ in curves)
     script = f"""
 set terminal pngcairo size 1400,600 font ',10'
 set output '{out_dir / 'latency_cdf.png'}'
