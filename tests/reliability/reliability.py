@@ -8,7 +8,6 @@ integration tests' harness, imported unchanged from tests/integration.
 
 import os
 import signal
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -126,16 +125,32 @@ def check_delivered_exactly_once(h, label, record, timeout_s=30.0):
     """Every valid frame the simulator sent reached reader `label` exactly once, in order, with the
     values sent: its JSON lines equal the simulator's record, line for line (so a sample lost,
     duplicated, reordered or altered fails; at > 1 kHz `time` repeats, but the packet number and
-    the values still pin each frame to its place in the sequence)."""
+    the values still pin each frame to its place in the sequence). Delivery is in order, so once the
+    last frame sent has arrived nothing earlier is still on its way."""
     sent = read_json_lines(record)
-    wait_for(lambda: len(logged_samples(h, label)) >= len(sent),
-             f"{label} to print all {len(sent)} samples", timeout_s)
+    wait_for(lambda: logged_samples(h, label)[-1:] == sent[-1:], f"{label} to print the last frame sent", timeout_s)
     received = logged_samples(h, label)
-    check(len(received) == len(sent), f"{label} printed {len(received)} samples for {len(sent)} valid frames")
+    check(len(received) == len(sent), f"{label} printed {len(received)} samples for {len(sent)} valid frames"
+                                      f"{missing_runs(sent, received)}")
     for index, (expected, actual) in enumerate(zip(sent, received)):
         check(actual == expected, f"{label}: sample {index} differs from the frame sent:\n"
                                   f"  sent {expected}\n  got  {actual}")
     return len(received)
+
+
+def missing_runs(sent, received):
+    """'; missing frames a..b, c..d' when `received` is `sent` with some frames left out, else ''."""
+    missing, at = [], 0
+    for index, frame in enumerate(sent):
+        if at < len(received) and received[at] == frame:
+            at += 1
+        elif not missing or missing[-1][1] != index - 1:
+            missing.append([index, index])
+        else:
+            missing[-1][1] = index
+    if at != len(received) or not missing:
+        return ""
+    return "; missing frames " + ", ".join(f"{a}..{b}" for a, b in missing)
 
 
 def stop_child(h, label, process):
@@ -199,7 +214,3 @@ def fastdds_shm_segments():
 
 def monotonic():
     return time.monotonic()
-
-
-def run_quietly(argv):
-    subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=False)
