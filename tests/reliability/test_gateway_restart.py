@@ -58,8 +58,6 @@ def body(h):
 
     restart_time = monotonic()
     restarted, restarted_stats, _ = start_gateway(h, RATE_HZ, port=port, label="gateway_restarted")
-    log(h, f"MEASURED the restarted gateway's first stats file {(monotonic() - restart_time) * 1000:.0f} ms "
-           f"after its start")
     first_after = wait_for(lambda: [s for s in probe.events("sample") if s["t"] > restart_time],
                            "the probe to get a sample from the restarted gateway")[0]
     last_before = [s for s in probe.events("sample") if s["t"] < restart_time][-1]
