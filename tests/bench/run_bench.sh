@@ -7,8 +7,8 @@
 #         BENCH_REPETITIONS=5    repetitions per benchmark; the tables show their median
 #   e2e   frames through a running rsg_gateway to a DDS reader, and baselines (rsg_bench_e2e):
 #         bench/results.json, results.md, latency_cdf.png (e2e_report.py), raw runs in bench/e2e/.
-#         About 6 minutes: 30 s per latency run, 10 s per max-rate step, and the 5-minute RSS soak
-#         running alongside them.
+#         About 7 minutes: 30 s per latency run, 10 s per max-rate step (UDP, then data-sharing),
+#         and the 5-minute RSS soak running alongside them.
 #         RSG_BENCH_FULL=1   120 s per latency run, 30 s per max-rate step, the soak on its own
 #                            afterwards (about 25 minutes, quieter numbers)
 #         RSG_BENCH_E2E_SECONDS, RSG_BENCH_E2E_STEP_SECONDS, RSG_BENCH_E2E_SOAK_SECONDS override
@@ -78,8 +78,10 @@ run_e2e() {
     echo "-- $scenario (${seconds} s, load average $(cut -d' ' -f1-3 /proc/loadavg))"
     "$bench" --scenario "$scenario" --duration "$seconds" --out "$runs/$scenario.json" --cdf "$runs/$scenario.cdf"
   done
-  echo "-- max_rate (${step_seconds} s per step)"
+  echo "-- max_rate (${step_seconds} s per step, UDP, then data-sharing)"
   "$bench" --scenario max_rate --duration "$step_seconds" --out "$runs/max_rate.json"
+  "$bench" --scenario max_rate --transport datasharing --duration "$step_seconds" \
+    --out "$runs/max_rate_datasharing.json"
   if $soak_concurrent; then
     echo "-- waiting for the soak"
     wait "$e2e_soak_pid"

@@ -30,7 +30,8 @@ using rsg::bench::transport_named;
 
 using Scenario = std::function<json(const BenchOptions&)>;
 
-std::map<std::string, Scenario> scenarios(const std::vector<double>& max_rate_steps) {
+std::map<std::string, Scenario> scenarios(const std::vector<double>& max_rate_steps,
+                                          const std::string& max_rate_transport) {
   using namespace rsg::bench;
   return {
       {"gateway_udp", [](const BenchOptions& o) { return run_gateway(o, transport_named("udp")); }},
@@ -43,7 +44,10 @@ std::map<std::string, Scenario> scenarios(const std::vector<double>& max_rate_st
       {"baseline_fastdds_datasharing",
        [](const BenchOptions& o) { return run_fastdds(o, transport_named("datasharing")); }},
       {"cyclone_ddsperf", [](const BenchOptions& o) { return run_ddsperf(o); }},
-      {"max_rate", [max_rate_steps](const BenchOptions& o) { return run_max_rate(o, max_rate_steps); }},
+      {"max_rate",
+       [=](const BenchOptions& o) {
+         return run_max_rate(o, transport_named(max_rate_transport), max_rate_steps);
+       }},
       // The RSS soak: a long gateway run over UDP (--duration 300).
       {"soak", [](const BenchOptions& o) { return run_gateway(o, transport_named("udp")); }},
   };
@@ -143,7 +147,7 @@ int main(int argc, char** argv) {
 
   CLI::App app("rsg_bench_e2e: end-to-end latency of rsg_gateway and its baselines", "rsg_bench_e2e");
   std::vector<std::string> names;
-  for (const auto& entry : scenarios({})) names.push_back(entry.first);
+  for (const auto& entry : scenarios({}, {})) names.push_back(entry.first);
   app.add_option("--scenario", scenario, "What to measure")->check(CLI::IsMember(names));
   app.add_flag("--smoke", smoke, "Send a few hundred frames through the gateway; fail unless they arrive");
   app.add_option("--rate", options.rate_hz, "Frames per second")->capture_default_str();
@@ -166,7 +170,8 @@ int main(int argc, char** argv) {
   app.add_flag("--keep-scratch", keep_scratch, "Keep the children's logs and stats files");
   app.add_option("--role", role, "(internal) run as the baseline's writer process")
       ->check(CLI::IsMember({"writer"}));
-  app.add_option("--transport", transport, "(writer role) udp, shm or datasharing");
+  app.add_option("--transport", transport, "max_rate and writer role: udp, shm or datasharing")
+      ->capture_default_str();
   app.add_option("--topic", options.topic, "(writer role) topic name");
   CLI11_PARSE(app, argc, argv);
 
@@ -201,7 +206,7 @@ int main(int argc, char** argv) {
     if (smoke) return run_smoke(options);
 
     const json load_at_start = load_average();
-    json result = scenarios(max_rate_steps).at(scenario)(options);
+    json result = scenarios(max_rate_steps, transport).at(scenario)(options);
     result["scenario"] = scenario;
     result["load_average"] = {{"start", load_at_start}, {"end", load_average()}};
     write_result(result, out);

@@ -36,6 +36,18 @@ std::int64_t rss_kb_of(pid_t pid) {
 
 ProcessUsage read_usage(pid_t pid) { return {Clock::now(), cpu_seconds_of(pid), rss_kb_of(pid)}; }
 
+std::uint64_t udp_receive_buffer_drops() {
+  // Two "Udp:" lines: the column names, then the values.
+  std::ifstream in("/proc/net/snmp");
+  std::string names, values;
+  for (std::string line; std::getline(in, line);)
+    if (line.starts_with("Udp:")) (names.empty() ? names : values) = line;
+  std::istringstream name_fields(names), value_fields(values);
+  for (std::string name, value; name_fields >> name && value_fields >> value;)
+    if (name == "RcvbufErrors") return std::stoull(value);
+  return 0;
+}
+
 double cpu_percent(const ProcessUsage& from, const ProcessUsage& to) {
   const double wall = std::chrono::duration<double>(to.at - from.at).count();
   return wall > 0 ? 100.0 * (to.cpu_seconds - from.cpu_seconds) / wall : 0.0;

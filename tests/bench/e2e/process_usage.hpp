@@ -21,4 +21,8 @@ ProcessUsage read_usage(pid_t pid);
 /// CPU time between two readings as a percentage of one core's wall time.
 double cpu_percent(const ProcessUsage& from, const ProcessUsage& to);
 
+/// Datagrams the kernel dropped so far because a UDP socket's receive buffer was full, on the
+/// whole host (Udp RcvbufErrors in /proc/net/snmp): where loss happened, when frames go missing.
+std::uint64_t udp_receive_buffer_drops();
+
 }  // namespace rsg::bench

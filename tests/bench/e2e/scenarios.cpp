@@ -30,9 +30,9 @@ using std::chrono::milliseconds;
 using std::chrono::seconds;
 
 constexpr std::array kTransports = {
-    Transport{"udp", "bench_udp", "bench_reader"},
-    Transport{"shm", "bench_shm", "bench_reader"},
+    Transport{"udp", "bench_udp", "bench_reader"}, Transport{"shm", "bench_shm", "bench_reader"},
     Transport{"datasharing", "bench_shm", "bench_reader_datasharing"},
+    Transport{"udp_4mb", "bench_udp_4mb", "bench_reader"},  // experiment: larger socket buffers
 };
 
 // The gateway's own default: 2 s of full frames at 1 kHz. The UDP baseline gets the same.
@@ -191,7 +191,8 @@ void require(bool condition, const std::string& what) {
 const Transport& transport_named(std::string_view name) {
   for (const Transport& transport : kTransports)
     if (transport.name == name) return transport;
-  throw std::invalid_argument("unknown transport '" + std::string(name) + "' (udp, shm, datasharing)");
+  throw std::invalid_argument("unknown transport '" + std::string(name) +
+                              "' (udp, shm, datasharing, udp_4mb)");
 }
 
 std::uint64_t BenchOptions::warmup_frames() const {
@@ -221,6 +222,7 @@ json run_gateway(const BenchOptions& options, const Transport& transport) {
 
   // CPU and RSS from the end of warm-up, so start-up and discovery are not counted.
   const ProcessUsage after_warmup = read_usage(gateway.pid());
+  const std::uint64_t drops_before = udp_receive_buffer_drops();
   json timeline = json::array();
   ProcessUsage last_usage = after_warmup;
   const auto usage_period = std::chrono::duration<double>(options.usage_period_s);
@@ -238,6 +240,7 @@ json run_gateway(const BenchOptions& options, const Transport& transport) {
   json result = latency_result(options, log, sending);
   result["transport"] = transport.name;
   result["data_sharing_used"] = maps_data_sharing_segment();
+  result["host_udp_receive_buffer_drops"] = udp_receive_buffer_drops() - drops_before;
   result["gateway"] = {{"cpu_percent", cpu_percent(after_warmup, at_end)},
                        {"rss_kb_after_warmup", after_warmup.rss_kb},
                        {"rss_kb_end", at_end.rss_kb},
@@ -247,7 +250,7 @@ json run_gateway(const BenchOptions& options, const Transport& transport) {
   return result;
 }
 
-json run_max_rate(const BenchOptions& options, const std::vector<double>& rates) {
+json run_max_rate(const BenchOptions& options, const Transport& transport, const std::vector<double>& rates) {
   json steps = json::array();
   double best = 0;
   for (const double rate : rates) {
@@ -255,7 +258,7 @@ json run_max_rate(const BenchOptions& options, const std::vector<double>& rates)
     step.rate_hz = rate;
     step.warmup_s = std::min(options.warmup_s, 1.0);
     step.cdf_file.clear();
-    json run = run_gateway(step, transport_named("udp"));
+    json run = run_gateway(step, transport);
     const bool kept_rate = run["achieved_rate_hz"].get<double>() >= kMinAchievedRateFraction * rate;
     const bool passed = kept_rate && run["lost"].get<std::uint64_t>() == 0;
     std::cerr << "rsg_bench_e2e: max rate: " << rate << " Hz: " << run["lost"] << " lost, sender at "
@@ -268,13 +271,17 @@ json run_max_rate(const BenchOptions& options, const std::vector<double>& rates)
                      {"p50_us", run["p50_us"]},
                      {"p99_us", run["p99_us"]},
                      {"gateway_cpu_percent", run["gateway"]["cpu_percent"]},
+                     {"host_udp_receive_buffer_drops", run["host_udp_receive_buffer_drops"]},
                      {"gateway_stats", run["gateway"]["stats"]},
                      {"passed", passed},
                      {"sender_kept_rate", kept_rate}});
     if (!passed) break;
     best = rate;
   }
-  return {{"max_rate_zero_loss_hz", best}, {"step_duration_s", options.duration_s}, {"steps", steps}};
+  return {{"max_rate_zero_loss_hz", best},
+          {"transport", transport.name},
+          {"step_duration_s", options.duration_s},
+          {"steps", steps}};
 }
 
 json run_udp_oneway(const BenchOptions& options) {

@@ -52,7 +52,8 @@ nlohmann::json run_gateway(const BenchOptions& options, const Transport& transpo
 
 /// Gateway runs of `duration_s` each at rising rates until one loses a frame or the sender
 /// cannot keep the rate; the highest rate without loss.
-nlohmann::json run_max_rate(const BenchOptions& options, const std::vector<double>& rates);
+nlohmann::json run_max_rate(const BenchOptions& options, const Transport& transport,
+                            const std::vector<double>& rates);
 
 /// Baseline: the same datagram over UDP loopback, one way.
 nlohmann::json run_udp_oneway(const BenchOptions& options);
