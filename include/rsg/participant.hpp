@@ -9,6 +9,7 @@
 #pragma once
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
@@ -26,6 +27,8 @@ class Participant {
   /// an empty profile name means Fast DDS's default participant QoS.
   /// Throws std::runtime_error when Fast DDS refuses.
   Participant(int domain, const std::string& profile);
+  /// Creates the participant from explicit QoS.
+  Participant(int domain, const fdds::DomainParticipantQos& qos);
   ~Participant();
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;

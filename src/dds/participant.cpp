@@ -17,6 +17,12 @@ Participant::Participant(int domain, const std::string& profile) {
                              " with profile '" + profile + "' (are the XML profiles loaded?)");
 }
 
+Participant::Participant(int domain, const fdds::DomainParticipantQos& qos) {
+  participant_ = fdds::DomainParticipantFactory::get_instance()->create_participant(domain, qos);
+  if (!participant_)
+    throw std::runtime_error("cannot create DDS participant on domain " + std::to_string(domain));
+}
+
 Participant::~Participant() {
   participant_->delete_contained_entities();
   fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);

@@ -6,7 +6,9 @@
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -60,6 +62,20 @@ void load_and_check_profiles(const GatewayConfig& config) {
             "data_reader", config.reader_profile);
 }
 
+// A gateway restarted after a crash must not come back on its predecessor's ports: readers still
+// hold the dead participant's state for those locators, and resumed only after 1.6-20 s in
+// tests/reliability/test_gateway_restart.py. A participant id taken from the pid gives a restart
+// other ports (Fast DDS moves on to free ports if these are taken). 60 ids keep every domain's
+// ports below 65536. A profile that sets <participantID> itself is left alone.
+fdds::DomainParticipantQos participant_qos(const std::string& profile) {
+  fdds::DomainParticipantQos qos;
+  if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(profile, qos) !=
+      ReturnCode_t::RETCODE_OK)
+    throw std::runtime_error("no participant profile named '" + profile + "'");
+  if (qos.wire_protocol().participant_id < 0) qos.wire_protocol().participant_id = ::getpid() % 60;
+  return qos;
+}
+
 std::vector<std::string> partitions_of(const GatewayConfig& config) {
   return config.partition.empty() ? std::vector<std::string>{} : std::vector<std::string>{config.partition};
 }
@@ -103,7 +119,7 @@ GatewaySetup prepare(const GatewayConfig& config) {
 
 Gateway::Gateway(const GatewaySetup& setup)
     : config_(setup.config),
-      participant_(config_.domain, config_.participant_profile),
+      participant_(config_.domain, participant_qos(config_.participant_profile)),
       status_(participant_, config_.status_topic, partitions_of(config_), config_.status_profile) {
   if (setup.ingress) {
     ingress_.emplace(participant_, *setup.ingress);
