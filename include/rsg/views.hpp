@@ -10,9 +10,9 @@
 // `reader_logger`):
 //
 //   rsg::Participant participant(domain, "rsg_participant");
-//   rsg::ViewReader joints(*participant.subscriber({"robot1"}),
-//   *participant.robot_state_topic("robot_state"),
-//                          "view_joints", "reader_realtime", &listener);
+//   auto* topic = participant.robot_state_topic("robot_state");
+//   rsg::ViewReader joints(*participant.subscriber({"robot1"}), *topic, "view_joints",
+//                          rsg::kRealtimeReaderProfile, &listener);
 //
 // Fast DDS evaluates the filter in the writer for remote UDP readers, so samples a view rejects
 // never cross the network; for data-sharing and intra-process readers it evaluates it in the reader.
