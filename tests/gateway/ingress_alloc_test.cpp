@@ -11,89 +11,23 @@
 // every allocation is made by Fast DDS's own code, none by rsg's; with the same profile made
 // BEST_EFFORT (a StatelessWriter) it asserts that nothing at all is allocated.
 //
-// Replaces the global operator new, hence a binary of its own, outside the sanitizer build.
-#include <dlfcn.h>
-#include <execinfo.h>
+// Counts through tests/support/allocation_counter.hpp: a binary of its own, outside the sanitizer build.
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <array>
-#include <cstdlib>
-#include <cstring>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <filesystem>
-#include <new>
 #include <random>
 #include <thread>
 
+#include "allocation_counter.hpp"
 #include "ingress.hpp"
 #include "random_state.hpp"
 #include "rsg/frame.hpp"
 #include "rsg/profiles.hpp"
-
-namespace {
-
-// Only this thread counts: Fast DDS's own threads (discovery, timers, receive) are not the hot path.
-thread_local bool counting = false;
-thread_local std::size_t by_fast_dds = 0;
-thread_local std::size_t by_rsg = 0;
-thread_local std::array<void*, 32> first_rsg_trace{};  // printed when the test fails
-thread_local int first_rsg_trace_depth = 0;
-
-// The code that called operator new is the first frame outside this executable (operator new and
-// everything inlined into rsg's code live in it). When that is libfastrtps, Fast DDS allocated;
-// anything else (rsg's code, or libstdc++ called from it) counts against rsg.
-bool called_from_fast_dds(void* const* frames, int depth) {
-  Dl_info self{};
-  ::dladdr(reinterpret_cast<void*>(&called_from_fast_dds), &self);
-  for (int i = 0; i < depth; ++i) {
-    Dl_info frame{};
-    if (!::dladdr(frames[i], &frame)) return false;
-    if (frame.dli_fbase == self.dli_fbase) continue;
-    return frame.dli_fname && std::strstr(frame.dli_fname, "libfastrtps");
-  }
-  return false;
-}
-
-void count_allocation() {
-  if (!counting) return;
-  counting = false;  // backtrace() and dladdr() must not count themselves
-  std::array<void*, 32> frames;
-  const int depth = ::backtrace(frames.data(), static_cast<int>(frames.size()));
-  if (called_from_fast_dds(frames.data(), depth)) {
-    ++by_fast_dds;
-  } else if (by_rsg++ == 0) {
-    first_rsg_trace = frames;
-    first_rsg_trace_depth = depth;
-  }
-  counting = true;
-}
-
-}  // namespace
-
-void* operator new(std::size_t size) {
-  count_allocation();
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void* operator new(std::size_t size, std::align_val_t alignment) {
-  count_allocation();
-  const std::size_t a = static_cast<std::size_t>(alignment);
-  if (void* p = std::aligned_alloc(a, (size + a - 1) / a * a)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size, std::align_val_t alignment) { return operator new(size, alignment); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 
 namespace rsg::gateway {
 namespace {
@@ -157,11 +91,6 @@ class IngressAllocation : public ::testing::Test {
               eprosima::fastrtps::xmlparser::XMLP_ret::XML_OK);
   }
 
-  void SetUp() override {
-    by_fast_dds = 0;
-    by_rsg = 0;
-  }
-
   static Ingress::Options options(const std::string& writer_profile) {
     Ingress::Options options;
     options.listen = Endpoint::parse("127.0.0.1:0");
@@ -214,10 +143,10 @@ class IngressAllocation : public ::testing::Test {
       }
       const bool measured = next > kWarmUp;
       do {
-        counting = measured;
+        if (measured) allocations_.resume();
         ingress.receive(10ms);
         ingress.link_changed(Clock::now());
-        counting = false;
+        allocations_.pause();
       } while (stats().ingress.received < received);
     }
 
@@ -238,12 +167,13 @@ class IngressAllocation : public ::testing::Test {
     return final_stats;
   }
 
-  static void expect_none_by_rsg() {
-    EXPECT_EQ(by_rsg, 0U) << "heap allocations by rsg on the ingress thread over " << kMeasured
-                          << " frames; the first one from:";
-    if (by_rsg) ::backtrace_symbols_fd(first_rsg_trace.data(), first_rsg_trace_depth, STDERR_FILENO);
+  void expect_none_by_rsg() const {
+    EXPECT_EQ(allocations_.by_rsg(), 0U) << "heap allocations by rsg on the ingress thread over " << kMeasured
+                                         << " frames; the first one from:\n"
+                                         << allocations_.first_by_rsg();
   }
 
+  test::AllocationCounter allocations_;
   const int domain_ = static_cast<int>(::getpid() % 200 + 10);
   Participant publishing_{domain_, "rsg_hot_path_udp"};
   Participant subscribing_{domain_, "rsg_hot_path_udp"};
@@ -252,15 +182,16 @@ class IngressAllocation : public ::testing::Test {
 TEST_F(IngressAllocation, WithTheGatewayProfileOnlyFastDdsReliableWriterAllocates) {
   stream("rsg_state_writer", fdds::RELIABLE_RELIABILITY_QOS);
   expect_none_by_rsg();
-  EXPECT_LE(by_fast_dds, kMeasured * kStatefulWriterAllocationsPerWrite)
+  EXPECT_LE(allocations_.by_fast_dds(), kMeasured * kStatefulWriterAllocationsPerWrite)
       << "Fast DDS allocates more per reliable write than 2.9.1 does";
-  std::printf("Fast DDS's reliable writer: %zu allocations over %zu frames\n", by_fast_dds, kMeasured);
+  std::printf("Fast DDS's reliable writer: %zu allocations over %zu frames\n", allocations_.by_fast_dds(),
+              kMeasured);
 }
 
 TEST_F(IngressAllocation, WithABestEffortWriterNothingAllocates) {
   stream("ingress_alloc_best_effort", fdds::BEST_EFFORT_RELIABILITY_QOS);
   expect_none_by_rsg();
-  EXPECT_EQ(by_fast_dds, 0U) << "Fast DDS allocated on the ingress thread";
+  EXPECT_EQ(allocations_.by_fast_dds(), 0U) << "Fast DDS allocated on the ingress thread";
 }
 
 }  // namespace
