@@ -108,8 +108,11 @@ void Ingress::reject(const FrameError& error, const Endpoint& sender) {
 
 void Ingress::publish(const FrameView& frame) {
   void* loan = nullptr;
+  // No initialisation of the loan: to_sample writes every member (header, group_present and each
+  // field, absent ones zeroed; robot_state_mapping_test checks it on poisoned memory), so
+  // constructing the sample first would only cost ~5 % of the gateway's CPU at 1 kHz.
   if (writer_loans_ &&
-      writer_->loan_sample(loan, fdds::DataWriter::LoanInitializationKind::CONSTRUCTED_LOAN_INITIALIZATION) ==
+      writer_->loan_sample(loan, fdds::DataWriter::LoanInitializationKind::NO_LOAN_INITIALIZATION) ==
           ReturnCode_t::RETCODE_OK) {
     to_sample(frame, *static_cast<RobotState*>(loan));
     if (writer_->write(loan)) {
