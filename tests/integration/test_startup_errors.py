@@ -1,8 +1,10 @@
 """Bad flags, files and profiles: one message naming the problem, exit status 2, and nothing
 started (the listening port is still free). Also: --allow-from rejects other senders."""
 
+import json
 import socket
 import sys
+from pathlib import Path
 
 from harness import check, main, read_json, wait_for_stats, free_udp_port
 
@@ -61,6 +63,29 @@ def body(h):
     check(final["frames_received"] == 0 and final["frames_published"] == 0, f"filtered gateway published: {final}")
     check(h.stop("filtered", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
     check(read_json(stats)["rejected_source"] == 50, "rejected_source changed after the stream ended")
+
+    # --allow-from 127.0.0.1/32: the same stream sent from 127.0.0.2 is dropped and counted, from
+    # 127.0.0.1 it is published. Both addresses are loopback, so only the filter tells them apart.
+    port = free_udp_port()
+    gateway, stats = h.gateway("allow_one", "--listen", f"0.0.0.0:{port}", "--allow-from", "127.0.0.1/32")
+    wait_for_stats(stats, lambda s: True, "the gateway to start")
+    frame = bytes.fromhex(first_valid_vector_hex())
+    for source, count in (("127.0.0.2", 30), ("127.0.0.1", 20)):
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
+            sender.bind((source, 0))
+            for _ in range(count):
+                sender.sendto(frame, ("127.0.0.1", port))
+    final = wait_for_stats(stats, lambda s: s["rejected_source"] + s["frames_received"] >= 50, "50 datagrams")
+    check(final["rejected_source"] == 30, f"datagrams from 127.0.0.2 not all rejected: {final}")
+    check(final["frames_received"] == 20 and final["frames_published"] == 20,
+          f"datagrams from 127.0.0.1 not all published: {final}")
+    check(h.stop("allow_one", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+
+
+def first_valid_vector_hex():
+    vectors = Path(__file__).resolve().parents[1] / "data" / "vectors" / "valid.jsonl"
+    with vectors.open() as lines:
+        return json.loads(next(lines))["frame_hex"]
 
 
 if __name__ == "__main__":
