@@ -2,6 +2,7 @@
 started (the listening port is still free). Also: --allow-from rejects other senders."""
 
 import json
+import os
 import socket
 import sys
 from pathlib import Path
@@ -80,6 +81,20 @@ def body(h):
     check(final["frames_received"] == 20 and final["frames_published"] == 20,
           f"datagrams from 127.0.0.1 not all published: {final}")
     check(h.stop("allow_one", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+
+    # A clean shutdown deletes every entity, so the gateway leaves nothing in /dev/shm (its
+    # data-sharing pools included) that could block or confuse the next start.
+    before = shared_memory()
+    gateway, stats = h.gateway("shutdown", "--listen", f"127.0.0.1:{free_udp_port()}")
+    wait_for_stats(stats, lambda s: True, "the gateway to start")
+    check(shared_memory() != before, "the gateway created no shared memory: the check below proves nothing")
+    check(h.stop("shutdown", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+    leftovers = shared_memory() - before
+    check(not leftovers, f"left in /dev/shm after SIGTERM: {sorted(leftovers)}")
+
+
+def shared_memory():
+    return set(os.listdir("/dev/shm"))
 
 
 def first_valid_vector_hex():
