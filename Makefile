@@ -10,6 +10,9 @@ FUZZ_SECONDS ?= 30
 ASAN_OPTIONS ?= new_delete_type_mismatch=0
 PACKAGES   := $(shell grep -v '^\s*\#' docker/packages.txt)
 SUDO       := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+# pipefail: a test run piped through tee must still fail the target.
+SHELL      := /bin/bash
+.SHELLFLAGS := -o pipefail -c
 
 .PHONY: all deps build test unit-asan fuzz fuzz-build demo bench format clean
 
@@ -32,7 +35,7 @@ build: deps
 unit-asan: deps
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DRSG_SANITIZE=ON
 	cmake --build $(ASAN_BUILD) -j $(JOBS) --target unit_tests
-	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) ctest --output-on-failure -L unit
+	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) ctest --output-on-failure -L unit 2>&1 | tee ctest.log
 
 fuzz-build: deps
 	CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_BUILD) -DRSG_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo
@@ -40,12 +43,14 @@ fuzz-build: deps
 
 # Each fuzzer for FUZZ_SECONDS (make fuzz FUZZ_SECONDS=600 for a long run).
 fuzz: fuzz-build
-	FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD)
+	FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD) 2>&1 | tee $(FUZZ_BUILD)/fuzz.log
 
+# Everything: all tests, the unit tests again under ASan+UBSan, every fuzzer for 30 s.
 test: build
-	cd $(BUILD) && ctest --output-on-failure -j 1
+	cd $(BUILD) && ctest --output-on-failure -j 1 2>&1 | tee ctest.log
 	$(MAKE) unit-asan
 	$(MAKE) fuzz FUZZ_SECONDS=30
+	@tests/summarize.sh $(BUILD)/ctest.log $(ASAN_BUILD)/ctest.log -- $(FUZZ_BUILD)/fuzz.log
 
 demo: build
 	src/tools/demo.sh $(BUILD)/bin
