@@ -151,6 +151,7 @@ class EchoViews(unittest.TestCase):
             "bad group": ["--groups", "2,9"],
             "view and groups": ["--view", "view_joints", "--groups", "2"],
             "unknown qos": ["--qos", "no_such_profile"],
+            "unknown participant profile": ["--participant-profile", "no_such_participant"],
             "unknown option": ["--frobnicate"],
         }
         for name, extra in cases.items():

@@ -14,6 +14,7 @@
 #include <fastdds/dds/core/LoanableSequence.hpp>
 #include <fastdds/dds/core/condition/GuardCondition.hpp>
 #include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <iostream>
 #include <optional>
@@ -49,6 +50,7 @@ struct Options {
   std::uint64_t count = 0;  // 0: no limit
   double timeout_seconds = 0;
   std::string profiles;
+  std::string participant_profile = "rsg_participant";
 };
 
 /// Turns SIGINT and SIGTERM into a trigger of `stop`. The signals are blocked in every thread
@@ -172,6 +174,9 @@ void add_options(CLI::App& app, Options& options) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--profiles", options.profiles, "XML profile file or directory")
       ->default_str(rsg::default_profiles_dir().string());
+  app.add_option("--participant-profile", options.participant_profile,
+                 "XML participant profile, e.g. rsg_secure_reader under DDS Security")
+      ->capture_default_str();
 }
 
 /// What the reader reads: a view, or the whole topic.
@@ -186,7 +191,7 @@ std::optional<rsg::View> requested_view(const Options& options, const fdds::Subs
 
 int run(const Options& options) {
   StopOnSignal::block_stop_signals();
-  rsg::Participant participant(options.domain, "rsg_participant");
+  rsg::Participant participant(options.domain, options.participant_profile);
   fdds::Topic& topic = *participant.robot_state_topic(options.topic);
   fdds::Subscriber& subscriber = *participant.subscriber(options.partitions);
 
@@ -291,6 +296,10 @@ int main(int argc, char** argv) {
   try {
     rsg::load_profiles(options.profiles.empty() ? rsg::default_profiles_dir()
                                                 : std::filesystem::path(options.profiles));
+    fdds::DomainParticipantQos unused;
+    if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
+            options.participant_profile, unused) != ReturnCode_t::RETCODE_OK)
+      throw std::runtime_error("no participant profile named '" + options.participant_profile + "'");
   } catch (const std::exception& error) {
     std::cerr << "rsg_echo: " << error.what() << '\n';
     return kExitUsage;
