@@ -49,7 +49,7 @@ struct Options {
   bool json = false;
   std::uint64_t count = 0;  // 0: no limit
   double timeout_seconds = 0;
-  std::string profiles;
+  std::vector<std::string> profiles;  // empty: rsg::default_profiles_dir()
   std::string participant_profile = "rsg_participant";
 };
 
@@ -172,7 +172,9 @@ void add_options(CLI::App& app, Options& options) {
                  "Exit 1 when no sample arrives for this many seconds, from start-up or the last "
                  "sample (default: wait forever)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--profiles", options.profiles, "XML profile file or directory")
+  app.add_option("--profiles", options.profiles,
+                 "XML profile file or directory; repeat to load several (e.g. rsg's profiles and a secure "
+                 "participant profile)")
       ->default_str(rsg::default_profiles_dir().string());
   app.add_option("--participant-profile", options.participant_profile,
                  "XML participant profile, e.g. rsg_secure_reader under DDS Security")
@@ -294,8 +296,8 @@ int main(int argc, char** argv) {
   }
 
   try {
-    rsg::load_profiles(options.profiles.empty() ? rsg::default_profiles_dir()
-                                                : std::filesystem::path(options.profiles));
+    if (options.profiles.empty()) rsg::load_profiles(rsg::default_profiles_dir());
+    for (const auto& profiles : options.profiles) rsg::load_profiles(profiles);
     fdds::DomainParticipantQos unused;
     if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
             options.participant_profile, unused) != ReturnCode_t::RETCODE_OK)
