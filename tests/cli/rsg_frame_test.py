@@ -57,25 +57,23 @@ class Decode(unittest.TestCase):
     def assert_same(self, actual, expected):
         self.assertTrue(same_value(actual, expected), f"\n  got      {actual}\n  expected {expected}")
 
-    def test_hex_lines_decode_every_valid_vector_by_value(self):
-        vectors = load_jsonl("valid.jsonl")
+    def decode_hex_lines(self, vectors):
+        """Decodes every vector's frame_hex in one --hex-lines run: one JSON object per vector."""
         status, out, err = run("decode", "--hex-lines",
                                stdin="".join(v["frame_hex"] + "\n" for v in vectors).encode())
         self.assertEqual((status, err), (0, ""))
         lines = out.decode().splitlines()
         self.assertEqual(len(lines), len(vectors))
-        for line, vector in zip(lines, vectors):
-            self.assert_same(json.loads(line), vector["decoded"])
+        return [json.loads(line) for line in lines]
+
+    def test_hex_lines_decode_every_valid_vector_by_value(self):
+        vectors = load_jsonl("valid.jsonl")
+        for decoded, vector in zip(self.decode_hex_lines(vectors), vectors):
+            self.assert_same(decoded, vector["decoded"])
 
     def test_hex_lines_report_the_category_of_every_invalid_vector(self):
         vectors = load_jsonl("invalid.jsonl")
-        status, out, err = run("decode", "--hex-lines",
-                               stdin="".join(v["frame_hex"] + "\n" for v in vectors).encode())
-        self.assertEqual((status, err), (0, ""))
-        lines = out.decode().splitlines()
-        self.assertEqual(len(lines), len(vectors))
-        for line, vector in zip(lines, vectors):
-            report = json.loads(line)
+        for report, vector in zip(self.decode_hex_lines(vectors), vectors):
             self.assertEqual(list(report), ["error", "message"])
             self.assertEqual(report["error"], vector["error"])
             self.assertTrue(report["message"])
