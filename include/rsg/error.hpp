@@ -41,7 +41,9 @@ constexpr std::optional<ErrorCategory> parse_error_category(std::string_view nam
 /// never allocates.
 class FrameError {
  public:
-  FrameError() = default;
+  // Only the terminator: every decode builds a FrameError, and clearing 112 bytes each time shows
+  // up in the codec's benchmark.
+  FrameError() { message_[0] = '\0'; }
   FrameError(ErrorCategory category, const char* format, ...) __attribute__((format(printf, 3, 4)));
 
   ErrorCategory category() const { return category_; }
@@ -50,7 +52,7 @@ class FrameError {
 
  private:
   ErrorCategory category_ = ErrorCategory::kNone;
-  std::array<char, 112> message_{};
+  std::array<char, 112> message_;  // NUL-terminated
 };
 
 }  // namespace rsg

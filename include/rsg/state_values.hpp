@@ -33,6 +33,7 @@ class StateValues {
   static const FieldLayout& layout();
   void* storage() { return storage_.data(); }
   const void* storage() const { return storage_.data(); }
+  static constexpr std::size_t storage_size() { return kStorageBytes; }
 
   friend bool operator==(const StateValues& a, const StateValues& b) {
     return a.packet_number == b.packet_number && a.selection == b.selection &&

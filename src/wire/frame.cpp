@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
-#include <type_traits>
-#include <utility>
 
+#include "crc32_copy.hpp"
 #include "group_bytes.hpp"
 #include "rsg/crc32.hpp"
 #include "rsg/error_flags.hpp"
+#include "rsg/frame_codec.hpp"
 
 namespace rsg {
 
@@ -130,77 +130,94 @@ bool check_encodable(std::uint8_t packet_number, const Selection& selection, std
   return true;
 }
 
-/// Calls `visit(std::integral_constant<std::size_t, I>{})` for each row I of the field table, unrolled
-/// at compile time: in the per-frame loops every row's mask, size and type become immediates instead
-/// of a chain of table loads, which takes about a quarter off copying a full frame.
-template <class Visit>
-void for_each_field_unrolled(Visit&& visit) {
-  [&visit]<std::size_t... I>(std::index_sequence<I...>) {
-    (visit(std::integral_constant<std::size_t, I>{}), ...);
+/// Step 8 of the spec on a struct about to be encoded, which may have been filled by anyone.
+bool check_values(const Selection& selection, const void* base, const FieldLayout& layout,
+                  FrameError& error) {
+  for (const FieldInfo& field : kRuledFields) {
+    if (!selection.contains(field.id())) continue;
+    const std::byte* value = layout.locate(base, field.id());
+    if (field.type == ElementType::kErrorSet) {
+      std::uint64_t bits;
+      std::memcpy(&bits, value, sizeof bits);
+      if (bits >> kErrorFlagCount) {  // a frame has room for flags 0..39 only
+        error = {ErrorCategory::kReservedBits, "%s has bits above flag 36 set", field.name.data()};
+        return false;
+      }
+    }
+    if (!check_value(field, value, error)) return false;
   }
-  (std::make_index_sequence<kFieldCount>{});
+  return true;
 }
 
-// Out of line so that the compiler calls the C library (vector code picked for this CPU) instead of
-// expanding a `rep movs`/`rep stos` where it can guess the size, which is slow to start.
-[[gnu::noinline]] void copy_bytes(void* to, const void* from, std::size_t size) {
-  std::memcpy(to, from, size);
+void zero_fills(const CopyPlan& plan, void* base) {
+  for (const ByteFill& fill : plan.fills())
+    std::memset(static_cast<std::byte*>(base) + fill.begin, 0, fill.size);
 }
-[[gnu::noinline]] void zero_bytes(void* to, std::size_t size) { std::memset(to, 0, size); }
-
-/// Merges the copies of consecutive fields into one memcpy for as long as source and destination
-/// both stay contiguous: a full frame copied to or from a struct laid out in field order takes a
-/// handful of calls instead of 44 small ones.
-class CoalescedCopy {
- public:
-  void add(void* to, const void* from, std::size_t size) {
-    auto* to_bytes = static_cast<std::byte*>(to);
-    auto* from_bytes = static_cast<const std::byte*>(from);
-    if (to_bytes == to_ + size_ && from_bytes == from_ + size_) {
-      size_ += size;
-      return;
-    }
-    flush();
-    to_ = to_bytes;
-    from_ = from_bytes;
-    size_ = size;
-  }
-  /// Performs the pending copy; call it before reading the destination.
-  void flush() {
-    if (size_ != 0) copy_bytes(to_, from_, size_);
-    size_ = 0;
-  }
-
- private:
-  std::byte* to_ = nullptr;
-  const std::byte* from_ = nullptr;
-  std::size_t size_ = 0;
-};
-
-/// The same for zeroing the fields a frame does not carry.
-class CoalescedZero {
- public:
-  void add(void* to, std::size_t size) {
-    auto* to_bytes = static_cast<std::byte*>(to);
-    if (to_bytes == to_ + size_) {
-      size_ += size;
-      return;
-    }
-    flush();
-    to_ = to_bytes;
-    size_ = size;
-  }
-  void flush() {
-    if (size_ != 0) zero_bytes(to_, size_);
-    size_ = 0;
-  }
-
- private:
-  std::byte* to_ = nullptr;
-  std::size_t size_ = 0;
-};
 
 }  // namespace
+
+namespace detail {
+
+/// The spec's validation, shared by `decode` and `FrameCodec::decode`, which copies the fields in
+/// the CRC pass. The header is read before the CRC so that the copy knows where the fields are;
+/// failures are still reported in the spec's order.
+class FrameDecoder {
+ public:
+  /// `checksum(covered, selection)` returns the CRC-32 of the covered bytes. `selection` points to
+  /// the frame's selection when the header is consistent with the frame's length (so a copy by it
+  /// stays inside the frame), else it is null.
+  template <class Checksum>
+  static DecodeResult decode(std::span<const std::uint8_t> bytes, Checksum&& checksum) noexcept {
+    DecodeResult result;
+    FrameError& error = result.error_;
+    if (bytes.size() < kMinFrameBytes) {
+      error = {ErrorCategory::kTruncated, "%zu bytes, a frame has at least %zu", bytes.size(),
+               kMinFrameBytes};
+      return result;
+    }
+    const std::uint16_t length = read_u16(bytes.data() + 1);
+    const std::size_t expected = kMinFrameBytes + length;
+    if (bytes.size() != expected) {
+      error = {bytes.size() < expected ? ErrorCategory::kTruncated : ErrorCategory::kLengthMismatch,
+               "%zu bytes, the length field (%u) implies %zu", bytes.size(), length, expected};
+      return result;
+    }
+    FrameView& frame = result.frame_;
+    frame.bytes_ = bytes;
+    frame.header_.packet_number = bytes[0] & 0x0F;
+    read_selection(bytes, frame.header_.selection);
+    frame.header_.length = length;
+    const Selection& selection = frame.header_.selection;
+    std::uint16_t offset = kHeaderBytes;
+    for (std::size_t group = 0; group < kGroupCount; ++group) {
+      frame.group_offsets_[group] = offset;
+      offset = static_cast<std::uint16_t>(offset + kSelectedBytes[group][selection.data_select[group]]);
+    }
+    const std::size_t selected_bytes = offset - kHeaderBytes;
+
+    // A header failure is kept in `error` and reported only once the CRC has passed.
+    const bool header_valid = check_header(bytes[0], selection, error);
+    const std::uint32_t computed = checksum(bytes.first(kHeaderBytes + length),
+                                            header_valid && selected_bytes == length ? &selection : nullptr);
+    const std::uint32_t trailer = read_u32(bytes.data() + kHeaderBytes + length);
+    if (computed != trailer) {
+      error = {ErrorCategory::kBadCrc, "trailer CRC is 0x%08x, computed 0x%08x", trailer, computed};
+      return result;
+    }
+    if (!header_valid) return result;
+    if (selected_bytes != length) {
+      error = {ErrorCategory::kLengthMismatch, "length field says %u data bytes, data_select implies %zu",
+               length, selected_bytes};
+      return result;
+    }
+    for (const FieldInfo& field : kRuledFields)
+      if (selection.contains(field.id()) && !check_value(field, frame.field_bytes(field.id()).data(), error))
+        return result;
+    return result;
+  }
+};
+
+}  // namespace detail
 
 std::span<const std::uint8_t> FrameView::field_bytes(Field field) const {
   if (!contains(field)) return {};
@@ -210,108 +227,53 @@ std::span<const std::uint8_t> FrameView::field_bytes(Field field) const {
 }
 
 DecodeResult decode(std::span<const std::uint8_t> bytes) noexcept {
-  DecodeResult result;
-  FrameError& error = result.error_;
-  if (bytes.size() < kMinFrameBytes) {
-    error = {ErrorCategory::kTruncated, "%zu bytes, a frame has at least %zu", bytes.size(), kMinFrameBytes};
-    return result;
-  }
-  const std::uint16_t length = read_u16(bytes.data() + 1);
-  const std::size_t expected = kMinFrameBytes + length;
-  if (bytes.size() != expected) {
-    error = {bytes.size() < expected ? ErrorCategory::kTruncated : ErrorCategory::kLengthMismatch,
-             "%zu bytes, the length field (%u) implies %zu", bytes.size(), length, expected};
-    return result;
-  }
-  const std::uint32_t computed = crc32(bytes.first(kHeaderBytes + length));
-  const std::uint32_t trailer = read_u32(bytes.data() + kHeaderBytes + length);
-  if (computed != trailer) {
-    error = {ErrorCategory::kBadCrc, "trailer CRC is 0x%08x, computed 0x%08x", trailer, computed};
-    return result;
-  }
-  FrameView& frame = result.frame_;
-  frame.bytes_ = bytes;
-  frame.header_.packet_number = bytes[0] & 0x0F;
-  read_selection(bytes, frame.header_.selection);
-  frame.header_.length = length;
-  const Selection& selection = frame.header_.selection;
-  if (!check_header(bytes[0], selection, error)) return result;
-
-  std::uint16_t offset = kHeaderBytes;
-  for (std::size_t group = 0; group < kGroupCount; ++group) {
-    frame.group_offsets_[group] = offset;
-    offset = static_cast<std::uint16_t>(offset + detail::kSelectedBytes[group][selection.data_select[group]]);
-  }
-  if (offset - kHeaderBytes != length) {
-    error = {ErrorCategory::kLengthMismatch, "length field says %u data bytes, data_select implies %zu",
-             length, offset - kHeaderBytes};
-    return result;
-  }
-  for (const FieldInfo& field : kRuledFields)
-    if (selection.contains(field.id()) && !check_value(field, frame.field_bytes(field.id()).data(), error))
-      return result;
-  return result;
+  return detail::FrameDecoder::decode(
+      bytes, [](std::span<const std::uint8_t> covered, const Selection*) { return crc32(covered); });
 }
 
 void copy_fields(const FrameView& frame, void* base, const FieldLayout& layout) noexcept {
-  const Selection& selection = frame.selection();
-  const std::uint8_t* wire = frame.bytes().data() + kHeaderBytes;
-  CoalescedCopy copy;
-  CoalescedZero zero;
-  for_each_field_unrolled([&](auto index) {
-    constexpr FieldInfo field = kFields[decltype(index)::value];
-    std::byte* value = layout.locate(base, field.id());
-    if (!selection.contains(field.id())) {
-      zero.add(value, field.value_bytes());
-      return;
-    }
-    if constexpr (field.type == ElementType::kErrorSet) {
-      const std::uint64_t bits = read_error_set(wire);  // 5 bytes on the wire, a uint64 in memory
-      std::memcpy(value, &bits, sizeof bits);
-    } else {
-      copy.add(value, wire, field.wire_bytes);  // every other type has the same bytes in both
-    }
-    wire += field.wire_bytes;
-  });
-  copy.flush();
-  zero.flush();
+  const CopyPlan plan(frame.selection(), layout);
+  detail::copy_to_struct(frame.bytes(), plan, static_cast<std::byte*>(base));
+  zero_fills(plan, base);
 }
 
 EncodeResult encode(std::uint8_t packet_number, const Selection& selection, const void* base,
                     const FieldLayout& layout, std::span<std::uint8_t> out) noexcept {
+  return FrameCodec(layout).encode(packet_number, selection, base, out);
+}
+
+FrameCodec::FrameCodec(const FieldLayout& layout) noexcept : layout_(&layout), plan_(Selection{}, layout) {}
+
+const ChunkedCopyPlan& FrameCodec::plan_for(const Selection& selection) noexcept {
+  // Not Selection's operator==, which calls memcmp: this runs for every frame.
+  const Selection& planned = plan_.plan().selection();
+  const bool same = planned.group_select == selection.group_select &&
+                    std::ranges::equal(planned.data_select, selection.data_select);
+  if (!same) plan_ = ChunkedCopyPlan(selection, *layout_);
+  return plan_;
+}
+
+DecodeResult FrameCodec::decode(std::span<const std::uint8_t> bytes, void* base) noexcept {
+  return detail::FrameDecoder::decode(
+      bytes, [&](std::span<const std::uint8_t> covered, const Selection* selection) {
+        if (selection == nullptr) return crc32(covered);
+        const ChunkedCopyPlan& plan = plan_for(*selection);
+        zero_fills(plan.plan(), base);
+        return detail::crc32_scatter(covered, plan, static_cast<std::byte*>(base));
+      });
+}
+
+EncodeResult FrameCodec::encode(std::uint8_t packet_number, const Selection& selection, const void* base,
+                                std::span<std::uint8_t> out) noexcept {
   EncodeResult result;
   const std::uint16_t length = selection.data_bytes();
   const std::size_t size = kMinFrameBytes + length;
   if (!check_encodable(packet_number, selection, size, out.size(), result.error)) return result;
-
-  std::uint8_t* wire = out.data() + write_header(packet_number, selection, length, out);
-  CoalescedCopy copy;
-  bool encodable = true;
-  for_each_field_unrolled([&](auto index) {
-    constexpr FieldInfo field = kFields[decltype(index)::value];
-    if (!encodable || !selection.contains(field.id())) return;
-    const std::byte* value = layout.locate(base, field.id());
-    if constexpr (field.type == ElementType::kErrorSet) {
-      std::uint64_t bits;
-      std::memcpy(&bits, value, sizeof bits);
-      if (bits >> kErrorFlagCount) {
-        result.error = {ErrorCategory::kReservedBits, "%s has bits above flag 36 set", field.name.data()};
-        encodable = false;
-        return;
-      }
-    }
-    if constexpr (has_value_rule(field.type)) {
-      if (!check_value(field, value, result.error)) {
-        encodable = false;
-        return;
-      }
-    }
-    copy.add(wire, value, field.wire_bytes);  // an error set's low 5 bytes are its wire form
-    wire += field.wire_bytes;
-  });
-  if (!encodable) return result;
-  copy.flush();
-  write_u32(wire, crc32(out.first(kHeaderBytes + length)));
+  if (!check_values(selection, base, *layout_, result.error)) return result;
+  write_header(packet_number, selection, length, out);
+  const std::uint32_t crc = detail::gather_crc32(out.first(kHeaderBytes + length), plan_for(selection),
+                                                 static_cast<const std::byte*>(base));
+  write_u32(out.data() + kHeaderBytes + length, crc);
   result.size = size;
   return result;
 }

@@ -1,5 +1,6 @@
 // decode() on arbitrary bytes. A frame it accepts must be exactly what encode() writes for the
-// values it carries, and the deframer must find it as one frame.
+// values it carries, and the deframer must find it as one frame. FrameCodec, which copies in the
+// CRC pass, must reach the same verdict and the same values.
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -8,11 +9,16 @@
 #include "fuzz_check.hpp"
 #include "rsg/deframer.hpp"
 #include "rsg/frame.hpp"
+#include "rsg/frame_codec.hpp"
 #include "rsg/state_values.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::span<const std::uint8_t> bytes(data, size);
   const rsg::DecodeResult result = rsg::decode(bytes);
+  rsg::StateValues stitched;
+  rsg::FrameCodec codec(rsg::StateValues::layout());
+  const rsg::DecodeResult stitched_result = codec.decode(bytes, stitched.storage());
+  FUZZ_REQUIRE(stitched_result.error().category() == result.error().category());
   if (!result) {
     FUZZ_REQUIRE(result.error().category() != rsg::ErrorCategory::kNone);
     FUZZ_REQUIRE(!result.error().message().empty());
@@ -21,6 +27,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   rsg::StateValues values;
   values.assign(result.frame());
+  stitched.packet_number = stitched_result.frame().packet_number();
+  stitched.selection = stitched_result.frame().selection();
+  FUZZ_REQUIRE(stitched == values);
   std::array<std::uint8_t, rsg::kMaxFrameBytes> encoded{};
   const rsg::EncodeResult reencoded = rsg::encode(values.packet_number, values.selection, values.storage(),
                                                   rsg::StateValues::layout(), encoded);

@@ -3,8 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include "rsg/crc32.hpp"
 #include "rsg/frame.hpp"
+#include "rsg/frame_codec.hpp"
 #include "rsg/json.hpp"
 #include "rsg/state_values.hpp"
 
@@ -58,6 +61,36 @@ TEST(Vectors, InvalidFramesFailWithTheSpecCategory) {
     EXPECT_EQ(result.error().category(), *expected)
         << "got " << to_string(result.error().category()) << ": " << result.error().message();
     EXPECT_FALSE(result.error().message().empty());
+  }
+}
+
+// The stitched decoder, one codec for all vectors so that its plan follows the selections.
+TEST(Vectors, ValidFramesDecodeThroughFrameCodec) {
+  FrameCodec codec(StateValues::layout());
+  for (const auto& vector : test::valid_vectors()) {
+    SCOPED_TRACE(vector.decoded_text.substr(0, 120));
+    StateValues decoded;
+    std::memset(decoded.storage(), 0xA5, StateValues::storage_size());  // stale values must not survive
+    const DecodeResult result = codec.decode(vector.frame, decoded.storage());
+    ASSERT_TRUE(result) << result.error().message();
+    decoded.packet_number = result.frame().packet_number();
+    decoded.selection = result.frame().selection();
+    StateValues expected;
+    std::string error;
+    ASSERT_TRUE(parse_canonical_json(vector.decoded_text, expected, error)) << error;
+    EXPECT_EQ(decoded, expected);
+  }
+}
+
+TEST(Vectors, InvalidFramesFailThroughFrameCodecWithTheSpecCategory) {
+  FrameCodec codec(StateValues::layout());
+  for (const auto& vector : test::invalid_vectors()) {
+    const auto expected = parse_error_category(vector.expected.get<std::string>());
+    ASSERT_TRUE(expected.has_value());
+    StateValues values;
+    const DecodeResult result = codec.decode(vector.frame, values.storage());
+    ASSERT_FALSE(result);
+    EXPECT_EQ(result.error().category(), *expected) << result.error().message();
   }
 }
 
