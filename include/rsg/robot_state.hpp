@@ -8,6 +8,7 @@
 
 #include "rsg/field_layout.hpp"
 #include "rsg/frame.hpp"
+#include "rsg/frame_codec.hpp"
 #include "rsg/state_values.hpp"
 
 namespace rsg {
@@ -27,5 +28,21 @@ EncodeResult to_frame(const RobotState& sample, std::span<std::uint8_t> out) noe
 
 /// The selection a sample carries.
 Selection selection_of(const RobotState& sample) noexcept;
+
+/// Frames <-> samples for one stream of frames, the way the gateway does it: the payload is
+/// copied in the same pass that checks the CRC (`FrameCodec`). Not thread-safe: one per stream.
+class RobotStateCodec {
+ public:
+  RobotStateCodec() noexcept : codec_(robot_state_layout()) {}
+
+  /// Validates `frame` and fills `sample` like `to_sample`. On failure `sample` holds garbage
+  /// (part of the rejected frame): never publish it.
+  DecodeResult decode(std::span<const std::uint8_t> frame, RobotState& sample) noexcept;
+  /// `to_frame`.
+  EncodeResult encode(const RobotState& sample, std::span<std::uint8_t> out) noexcept;
+
+ private:
+  FrameCodec codec_;
+};
 
 }  // namespace rsg

@@ -69,4 +69,14 @@ EncodeResult to_frame(const RobotState& sample, std::span<std::uint8_t> out) noe
   return encode(sample.packet_number(), selection_of(sample), &sample, robot_state_layout(), out);
 }
 
+DecodeResult RobotStateCodec::decode(std::span<const std::uint8_t> frame, RobotState& sample) noexcept {
+  DecodeResult result = codec_.decode(frame, &sample);
+  if (result) set_header(result.frame().packet_number(), result.frame().selection(), sample);
+  return result;
+}
+
+EncodeResult RobotStateCodec::encode(const RobotState& sample, std::span<std::uint8_t> out) noexcept {
+  return codec_.encode(sample.packet_number(), selection_of(sample), &sample, out);
+}
+
 }  // namespace rsg

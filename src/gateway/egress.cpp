@@ -76,7 +76,7 @@ void Egress::forward_available() {
 
 void Egress::forward(const RobotState& sample) {
   samples_.fetch_add(1, std::memory_order_relaxed);
-  const EncodeResult encoded = to_frame(sample, frame_);
+  const EncodeResult encoded = codec_.encode(sample, frame_);
   if (!encoded) {
     unencodable_.fetch_add(1, std::memory_order_relaxed);
     last_encode_error_ = encoded.error;

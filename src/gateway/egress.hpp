@@ -3,7 +3,7 @@
 // Runs its own thread, woken by a WaitSet when samples arrive, so a slow DDS side never stalls
 // ingress. Samples are taken as loans (zero-copy with data-sharing) and encoded into one buffer
 // allocated at start-up. A frame that went raw -> DDS -> raw comes out byte-identical, because
-// the sample keeps the packet number and the selection and `to_frame` rewrites exactly that.
+// the sample keeps the packet number and the selection and the encoder rewrites exactly that.
 #pragma once
 
 #include <array>
@@ -19,11 +19,8 @@
 #include "rsg/gateway/log_throttle.hpp"
 #include "rsg/gateway/stats.hpp"
 #include "rsg/participant.hpp"
+#include "rsg/robot_state.hpp"
 #include "rsg/udp_socket.hpp"
-
-namespace rsg {
-class RobotState;
-}
 
 namespace rsg::gateway {
 
@@ -64,6 +61,7 @@ class Egress {
   fdds::DataReader* reader_ = nullptr;
   std::vector<Destination> destinations_;
   std::array<std::uint8_t, kMaxFrameBytes> frame_{};
+  RobotStateCodec codec_;  // used by the forwarding thread only
 
   fdds::WaitSet waitset_;
   fdds::GuardCondition stop_;

@@ -2,8 +2,8 @@
 //
 // Runs on the caller's thread (the gateway's main loop); everything it counts is read on that
 // same thread, so the hot path takes no lock. Per wake-up it does one poll, then takes the queued
-// datagrams in batches (recvmmsg) into buffers allocated at start-up; per datagram one decode,
-// one copy of the payload into a loaned (or preallocated) sample and one write. It allocates
+// datagrams in batches (recvmmsg) into buffers allocated at start-up; per datagram one pass that
+// checks the CRC and copies the payload into a loaned (or preallocated) sample, and one write. It allocates
 // nothing and logs nothing; tests/gateway/ingress_alloc_test.cpp holds it to that (and shows that
 // Fast DDS 2.9.1's reliable writer still allocates inside write()).
 #pragma once
@@ -76,7 +76,6 @@ class Ingress {
  private:
   void handle(const DatagramBatch::Datagram& datagram, Clock::time_point now);
   void reject(const FrameError& error, const Endpoint& sender);
-  void publish(const FrameView& frame);
   void request_selection(const Endpoint& robot, Clock::time_point now);
 
   Options options_;
@@ -88,6 +87,7 @@ class Ingress {
 
   // One frame per buffer: anything longer arrives marked truncated and is rejected unread.
   DatagramBatch batch_;
+  RobotStateCodec codec_;
   RobotState fallback_sample_;  // when the writer cannot loan: the one preallocated sample
 
   IngressCounters counters_;

@@ -45,13 +45,12 @@ std::vector<std::vector<std::uint8_t>> make_frames(int count) {
 TEST(HotPath, DecodeIntoASampleAllocatesNothing) {
   const auto frames = make_frames(64);
   RobotState sample;
+  RobotStateCodec codec;
   std::size_t decoded = 0;
   test::AllocationCounter allocations;
   allocations.resume();
-  for (int i = 0; i < kMeasured; ++i) {
-    const DecodeResult result = decode(frames[static_cast<std::size_t>(i) % frames.size()]);
-    if (result) to_sample(result.frame(), sample), ++decoded;
-  }
+  for (int i = 0; i < kMeasured; ++i)
+    decoded += static_cast<bool>(codec.decode(frames[static_cast<std::size_t>(i) % frames.size()], sample));
   allocations.pause();
   EXPECT_EQ(decoded, static_cast<std::size_t>(kMeasured));
   EXPECT_EQ(allocations.total(), 0U) << allocations.first_by_rsg();
@@ -97,12 +96,14 @@ void expect_no_allocations_while_publishing(const std::string& profile, bool rea
   ASSERT_EQ(matched.current_count, 1) << "the reader never matched";
 
   const auto frames = make_frames(64);
+  RobotStateCodec codec;
   auto publish = [&](const std::vector<std::uint8_t>& frame) {
-    const DecodeResult result = decode(frame);
-    if (!result) return false;
     void* loan = nullptr;
     if (writer->loan_sample(loan) != ReturnCode_t::RETCODE_OK) return false;
-    to_sample(result.frame(), *static_cast<RobotState*>(loan));
+    if (!codec.decode(frame, *static_cast<RobotState*>(loan))) {
+      writer->discard_loan(loan);
+      return false;
+    }
     return writer->write(loan);
   };
   for (int i = 0; i < kWarmUp; ++i) ASSERT_TRUE(publish(frames[static_cast<std::size_t>(i) % frames.size()]));
