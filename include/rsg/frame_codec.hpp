@@ -33,10 +33,12 @@ class FrameCodec {
                       std::span<std::uint8_t> out) noexcept;
 
  private:
-  const ChunkedCopyPlan& plan_for(const Selection& selection) noexcept;
+  const ChunkedCopyPlan& plan_for(const Selection& selection, std::uint64_t key) noexcept;
+  void replan(const Selection& selection, std::uint64_t key) noexcept;
 
   const FieldLayout* layout_;
   ChunkedCopyPlan plan_;
+  std::uint64_t plan_key_;  // plan_'s selection as 7 header bytes
 };
 
 }  // namespace rsg

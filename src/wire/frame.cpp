@@ -149,6 +149,21 @@ bool check_values(const Selection& selection, const void* base, const FieldLayou
   return true;
 }
 
+/// A selection's 7 bytes as one integer, the way they sit in a header (bytes 3..9).
+std::uint64_t selection_key(const Selection& selection) {
+  std::uint64_t data_select = 0;
+  std::memcpy(&data_select, selection.data_select.data(), kGroupCount);
+  return data_select << 8 | selection.group_select;
+}
+
+/// The same read from the frame's bytes rather than from the Selection just filled from them:
+/// reloading freshly stored bytes at another width would stall on store-to-load forwarding.
+std::uint64_t selection_key(std::span<const std::uint8_t> frame) {
+  std::uint64_t key = 0;
+  std::memcpy(&key, frame.data() + 3, 1 + kGroupCount);
+  return key;
+}
+
 void zero_fills(const CopyPlan& plan, void* base) {
   for (const ByteFill& fill : plan.fills())
     std::memset(static_cast<std::byte*>(base) + fill.begin, 0, fill.size);
@@ -242,22 +257,26 @@ EncodeResult encode(std::uint8_t packet_number, const Selection& selection, cons
   return FrameCodec(layout).encode(packet_number, selection, base, out);
 }
 
-FrameCodec::FrameCodec(const FieldLayout& layout) noexcept : layout_(&layout), plan_(Selection{}, layout) {}
+FrameCodec::FrameCodec(const FieldLayout& layout) noexcept
+    : layout_(&layout), plan_(Selection{}, layout), plan_key_(selection_key(Selection{})) {}
 
-const ChunkedCopyPlan& FrameCodec::plan_for(const Selection& selection) noexcept {
-  // Not Selection's operator==, which calls memcmp: this runs for every frame.
-  const Selection& planned = plan_.plan().selection();
-  const bool same = planned.group_select == selection.group_select &&
-                    std::ranges::equal(planned.data_select, selection.data_select);
-  if (!same) plan_ = ChunkedCopyPlan(selection, *layout_);
+const ChunkedCopyPlan& FrameCodec::plan_for(const Selection& selection, std::uint64_t key) noexcept {
+  if (key != plan_key_) replan(selection, key);
   return plan_;
+}
+
+// Out of line: the plan under construction takes kilobytes of stack, which the per-frame path
+// should not have to set up.
+[[gnu::noinline]] void FrameCodec::replan(const Selection& selection, std::uint64_t key) noexcept {
+  plan_ = ChunkedCopyPlan(selection, *layout_);
+  plan_key_ = key;
 }
 
 DecodeResult FrameCodec::decode(std::span<const std::uint8_t> bytes, void* base) noexcept {
   return detail::FrameDecoder::decode(
       bytes, [&](std::span<const std::uint8_t> covered, const Selection* selection) {
         if (selection == nullptr) return crc32(covered);
-        const ChunkedCopyPlan& plan = plan_for(*selection);
+        const ChunkedCopyPlan& plan = plan_for(*selection, selection_key(covered));
         zero_fills(plan.plan(), base);
         return detail::crc32_scatter(covered, plan, static_cast<std::byte*>(base));
       });
@@ -271,8 +290,9 @@ EncodeResult FrameCodec::encode(std::uint8_t packet_number, const Selection& sel
   if (!check_encodable(packet_number, selection, size, out.size(), result.error)) return result;
   if (!check_values(selection, base, *layout_, result.error)) return result;
   write_header(packet_number, selection, length, out);
-  const std::uint32_t crc = detail::gather_crc32(out.first(kHeaderBytes + length), plan_for(selection),
-                                                 static_cast<const std::byte*>(base));
+  const std::uint32_t crc =
+      detail::gather_crc32(out.first(kHeaderBytes + length), plan_for(selection, selection_key(selection)),
+                           static_cast<const std::byte*>(base));
   write_u32(out.data() + kHeaderBytes + length, crc);
   result.size = size;
   return result;
