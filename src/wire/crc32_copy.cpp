@@ -178,11 +178,50 @@ class WholeRuns {
   std::ptrdiff_t delta_ = 0;
 };
 
+/// What decoding and encoding share: four chunks inside one run of whole chunks are one block
+/// copy, `Direction::block` says from where to where.
+template <class Direction>
+class ChunkCopy {
+ public:
+  explicit ChunkCopy(const ChunkedCopyPlan& plan) : runs_(plan) {}
+
+  /// The four chunks from `at` on, copied.
+  RSG_STITCHED_INLINE void round(std::size_t at, __m512i& c0, __m512i& c1, __m512i& c2, __m512i& c3) {
+    auto& direction = static_cast<Direction&>(*this);
+    if (!runs_.cover(at, kRoundBytes)) {
+      c0 = direction(at, kWholeChunk);
+      c1 = direction(at + kChunkBytes, kWholeChunk);
+      c2 = direction(at + 2 * kChunkBytes, kWholeChunk);
+      c3 = direction(at + 3 * kChunkBytes, kWholeChunk);
+      return;
+    }
+    const auto [from, to] = direction.block(at, runs_.delta());
+    c0 = _mm512_loadu_si512(from);
+    c1 = _mm512_loadu_si512(from + kChunkBytes);
+    c2 = _mm512_loadu_si512(from + 2 * kChunkBytes);
+    c3 = _mm512_loadu_si512(from + 3 * kChunkBytes);
+    _mm512_storeu_si512(to, c0);
+    _mm512_storeu_si512(to + kChunkBytes, c1);
+    _mm512_storeu_si512(to + 2 * kChunkBytes, c2);
+    _mm512_storeu_si512(to + 3 * kChunkBytes, c3);
+  }
+
+ protected:
+  WholeRuns runs_;
+};
+
+struct Block {
+  const std::byte* from;
+  std::byte* to;
+};
+
 /// Decoding: each chunk is read from the frame and written to the struct where the plan says.
-class ScatterChunks {
+class ScatterChunks : public ChunkCopy<ScatterChunks> {
  public:
   ScatterChunks(const std::uint8_t* frame, const ChunkedCopyPlan& plan, std::byte* base)
-      : frame_(padded_origin(frame, plan.head_padding())), runs_(plan), base_(base) {}
+      : ChunkCopy(plan),
+        frame_(padded_origin(reinterpret_cast<const std::byte*>(frame), plan.head_padding())),
+        base_(base) {}
 
   /// The padded frame's bytes [at, at + 64) that `valid` selects, the others zero.
   RSG_STITCHED_INLINE __m512i operator()(std::size_t at, __mmask64 valid) {
@@ -199,38 +238,23 @@ class ScatterChunks {
     return bytes;
   }
 
-  /// The four chunks from `at` on: in the middle of a long move, one block copy.
-  RSG_STITCHED_INLINE void round(std::size_t at, __m512i& c0, __m512i& c1, __m512i& c2, __m512i& c3) {
-    if (!runs_.cover(at, kRoundBytes)) {
-      c0 = (*this)(at, kWholeChunk);
-      c1 = (*this)(at + kChunkBytes, kWholeChunk);
-      c2 = (*this)(at + 2 * kChunkBytes, kWholeChunk);
-      c3 = (*this)(at + 3 * kChunkBytes, kWholeChunk);
-      return;
-    }
-    c0 = _mm512_loadu_si512(frame_ + at);
-    c1 = _mm512_loadu_si512(frame_ + at + kChunkBytes);
-    c2 = _mm512_loadu_si512(frame_ + at + 2 * kChunkBytes);
-    c3 = _mm512_loadu_si512(frame_ + at + 3 * kChunkBytes);
-    std::byte* to = struct_address(base_, at, runs_.delta());
-    _mm512_storeu_si512(to, c0);
-    _mm512_storeu_si512(to + kChunkBytes, c1);
-    _mm512_storeu_si512(to + 2 * kChunkBytes, c2);
-    _mm512_storeu_si512(to + 3 * kChunkBytes, c3);
+  RSG_STITCHED_INLINE Block block(std::size_t at, std::ptrdiff_t delta) const {
+    return {frame_ + at, struct_address(base_, at, delta)};
   }
 
  private:
-  const std::uint8_t* frame_;
-  WholeRuns runs_;
+  const std::byte* frame_;
   std::byte* base_;
 };
 
 /// Encoding: each chunk is assembled from the struct where the plan says, the rest (the header)
 /// kept from the frame.
-class GatherChunks {
+class GatherChunks : public ChunkCopy<GatherChunks> {
  public:
   GatherChunks(std::uint8_t* frame, const ChunkedCopyPlan& plan, const std::byte* base)
-      : frame_(padded_origin(frame, plan.head_padding())), runs_(plan), base_(base) {}
+      : ChunkCopy(plan),
+        frame_(padded_origin(reinterpret_cast<std::byte*>(frame), plan.head_padding())),
+        base_(base) {}
 
   RSG_STITCHED_INLINE __m512i operator()(std::size_t at, __mmask64 valid) {
     if (runs_.cover(at, kChunkBytes)) {
@@ -251,32 +275,16 @@ class GatherChunks {
     if (valid == kWholeChunk)
       _mm512_storeu_si512(frame_ + at, bytes);
     else  // the first chunk, which starts with padding
-      store_range(reinterpret_cast<std::byte*>(frame_ + at), bytes, first_byte(valid), byte_count(valid));
+      store_range(frame_ + at, bytes, first_byte(valid), byte_count(valid));
     return bytes;
   }
 
-  RSG_STITCHED_INLINE void round(std::size_t at, __m512i& c0, __m512i& c1, __m512i& c2, __m512i& c3) {
-    if (!runs_.cover(at, kRoundBytes)) {
-      c0 = (*this)(at, kWholeChunk);
-      c1 = (*this)(at + kChunkBytes, kWholeChunk);
-      c2 = (*this)(at + 2 * kChunkBytes, kWholeChunk);
-      c3 = (*this)(at + 3 * kChunkBytes, kWholeChunk);
-      return;
-    }
-    const std::byte* from = struct_address(base_, at, runs_.delta());
-    c0 = _mm512_loadu_si512(from);
-    c1 = _mm512_loadu_si512(from + kChunkBytes);
-    c2 = _mm512_loadu_si512(from + 2 * kChunkBytes);
-    c3 = _mm512_loadu_si512(from + 3 * kChunkBytes);
-    _mm512_storeu_si512(frame_ + at, c0);
-    _mm512_storeu_si512(frame_ + at + kChunkBytes, c1);
-    _mm512_storeu_si512(frame_ + at + 2 * kChunkBytes, c2);
-    _mm512_storeu_si512(frame_ + at + 3 * kChunkBytes, c3);
+  RSG_STITCHED_INLINE Block block(std::size_t at, std::ptrdiff_t delta) const {
+    return {struct_address(base_, at, delta), frame_ + at};
   }
 
  private:
-  std::uint8_t* frame_;
-  WholeRuns runs_;
+  std::byte* frame_;
   const std::byte* base_;
 };
 

@@ -79,60 +79,81 @@ class StitchedKernel : public ::testing::Test {
   }
 };
 
+/// A random kernel input: selection, layout and plan, a frame and a struct placed near a page end
+/// half of the time (where the kernel's masked accesses must still be exact), and a copy of the
+/// destination with 64 bytes either side, which the plain path works on for comparison.
+class KernelCase {
+ public:
+  static constexpr std::size_t kMargin = 64;
+
+  KernelCase(std::mt19937_64& rng, Arena& arena, bool struct_is_destination)
+      : selection_(random_selection(rng)),
+        layout_(random_layout(rng, struct_size_)),
+        plan_(selection_, layout_),
+        frame_(reinterpret_cast<std::uint8_t*>(arena.at(kPage + anywhere_or_at_page_end(rng, 128))),
+               kHeaderBytes + selection_.data_bytes()),
+        struct_(arena.at(4 * kPage + anywhere_or_at_page_end(rng, 160)), struct_size_),
+        destination_(struct_is_destination ? struct_ : std::as_writable_bytes(frame_)) {
+    fill_random({reinterpret_cast<std::byte*>(frame_.data()) - kMargin, frame_.size() + 2 * kMargin}, rng);
+    fill_random({struct_.data() - kMargin, struct_.size() + 2 * kMargin}, rng);
+    expected_.assign(destination_.data() - kMargin, destination_.data() + destination_.size() + kMargin);
+  }
+
+  const ChunkedCopyPlan& plan() const { return plan_; }
+  std::span<std::uint8_t> frame() { return frame_; }
+  std::byte* struct_base() { return struct_.data(); }
+  /// The destination as the plain path sees it: inside the copy.
+  std::span<std::uint8_t> expected_frame() {
+    return {reinterpret_cast<std::uint8_t*>(expected_.data() + kMargin), frame_.size()};
+  }
+  std::byte* expected_struct() { return expected_.data() + kMargin; }
+  /// Whether the destination and its margins now equal the copy.
+  bool same_as_expected() const {
+    return std::equal(expected_.begin(), expected_.end(), destination_.data() - kMargin);
+  }
+
+ private:
+  static std::size_t anywhere_or_at_page_end(std::mt19937_64& rng, std::size_t reach) {
+    return rng() % 2 ? kPage - rng() % reach : rng() % kPage;
+  }
+
+  Selection selection_;
+  std::size_t struct_size_ = 0;
+  FieldLayout layout_;
+  ChunkedCopyPlan plan_;
+  std::span<std::uint8_t> frame_;
+  std::span<std::byte> struct_;
+  std::span<std::byte> destination_;
+  std::vector<std::byte> expected_;
+};
+
 TEST_F(StitchedKernel, ScatterMatchesIsalAndMemcpy) {
   std::mt19937_64 rng(20261121);
-  Arena arena(4);
+  Arena arena(8);
   for (int round = 0; round < 20'000; ++round) {
-    const Selection selection = random_selection(rng);
-    std::size_t struct_size = 0;
-    const FieldLayout layout = random_layout(rng, struct_size);
-    const ChunkedCopyPlan plan(selection, layout);
-    const std::size_t frame_size = kHeaderBytes + selection.data_bytes();
-
-    // Near a page end half of the time: the kernel's masked accesses must stay correct there.
-    const std::size_t frame_at = rng() % 2 ? kPage - rng() % 128 : rng() % kPage;
-    const std::size_t struct_at = 2 * kPage + (rng() % 2 ? kPage - rng() % 160 : rng() % kPage);
-    const std::span frame(reinterpret_cast<std::uint8_t*>(arena.at(frame_at)), frame_size);
-    fill_random(std::as_writable_bytes(frame), rng);
-    std::vector<std::byte> expected(struct_size);
-    fill_random(expected, rng);
-    std::byte* actual = arena.at(struct_at);
-    std::memcpy(actual, expected.data(), struct_size);
-
-    const std::uint32_t expected_crc = detail::crc32_scatter_portable(frame, plan, expected.data());
-    const std::uint32_t actual_crc = detail::crc32_scatter_stitched(frame, plan, actual);
-    ASSERT_EQ(actual_crc, crc32(frame)) << "round " << round;
-    ASSERT_EQ(actual_crc, expected_crc);
-    ASSERT_EQ(std::memcmp(actual, expected.data(), struct_size), 0) << "round " << round;
+    KernelCase input(rng, arena, /*struct_is_destination=*/true);
+    const std::uint32_t expected =
+        detail::crc32_scatter_portable(input.frame(), input.plan(), input.expected_struct());
+    const std::uint32_t actual =
+        detail::crc32_scatter_stitched(input.frame(), input.plan(), input.struct_base());
+    ASSERT_EQ(actual, crc32(input.frame())) << "round " << round;
+    ASSERT_EQ(actual, expected);
+    ASSERT_TRUE(input.same_as_expected()) << "round " << round;
   }
 }
 
 TEST_F(StitchedKernel, GatherMatchesMemcpyAndIsal) {
   std::mt19937_64 rng(7);
-  Arena arena(4);
-  std::vector<std::uint8_t> expected(kMaxFrameBytes + 128);  // the frame and 64 bytes either side
+  Arena arena(8);
   for (int round = 0; round < 20'000; ++round) {
-    const Selection selection = random_selection(rng);
-    std::size_t struct_size = 0;
-    const FieldLayout layout = random_layout(rng, struct_size);
-    const ChunkedCopyPlan plan(selection, layout);
-    const std::size_t frame_size = kHeaderBytes + selection.data_bytes();
-
-    const std::size_t struct_at = rng() % 2 ? kPage - rng() % 160 : rng() % kPage;
-    const std::size_t frame_at = 2 * kPage + (rng() % 2 ? kPage - rng() % 128 : rng() % kPage);
-    fill_random({arena.at(struct_at), struct_size}, rng);
-    // The bytes around the frame must stay untouched.
-    const std::span around(reinterpret_cast<std::uint8_t*>(arena.at(frame_at - 64)), frame_size + 128);
-    fill_random(std::as_writable_bytes(around), rng);
-    const std::span frame = around.subspan(64, frame_size);
-    std::copy(around.begin(), around.end(), expected.begin());
-    const std::span expected_frame = std::span(expected).subspan(64, frame_size);
-
-    const std::uint32_t expected_crc =
-        detail::gather_crc32_portable(expected_frame, plan, arena.at(struct_at));
-    const std::uint32_t actual_crc = detail::gather_crc32_stitched(frame, plan, arena.at(struct_at));
-    ASSERT_EQ(actual_crc, expected_crc) << "round " << round;
-    ASSERT_TRUE(std::equal(around.begin(), around.end(), expected.begin())) << "round " << round;
+    KernelCase input(rng, arena, /*struct_is_destination=*/false);
+    const std::uint32_t expected =
+        detail::gather_crc32_portable(input.expected_frame(), input.plan(), input.struct_base());
+    const std::uint32_t actual =
+        detail::gather_crc32_stitched(input.frame(), input.plan(), input.struct_base());
+    ASSERT_EQ(actual, expected) << "round " << round;
+    ASSERT_EQ(actual, crc32(input.frame()));
+    ASSERT_TRUE(input.same_as_expected()) << "round " << round;
   }
 }
 
