@@ -388,11 +388,15 @@ std::uint32_t crc32_scatter_portable(std::span<const std::uint8_t> frame, const 
   return crc32(frame);
 }
 
-std::uint32_t gather_crc32_portable(std::span<std::uint8_t> frame, const ChunkedCopyPlan& plan,
-                                    const std::byte* base) noexcept {
-  for (const ByteMove& move : plan.plan().moves())
+void copy_to_frame(std::span<std::uint8_t> frame, const CopyPlan& plan, const std::byte* base) noexcept {
+  for (const ByteMove& move : plan.moves())
     std::memcpy(frame.data() + move.frame_begin, base + (move.frame_begin + move.struct_delta),
                 move.frame_end - move.frame_begin);
+}
+
+std::uint32_t gather_crc32_portable(std::span<std::uint8_t> frame, const ChunkedCopyPlan& plan,
+                                    const std::byte* base) noexcept {
+  copy_to_frame(frame, plan.plan(), base);
   return crc32(frame);
 }
 

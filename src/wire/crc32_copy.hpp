@@ -24,8 +24,9 @@ std::uint32_t crc32_scatter(std::span<const std::uint8_t> frame, const ChunkedCo
 std::uint32_t gather_crc32(std::span<std::uint8_t> frame, const ChunkedCopyPlan& plan,
                            const std::byte* base) noexcept;
 
-/// The moves alone, without a CRC: frame to struct.
+/// The moves alone, without a CRC: frame to struct, and struct to frame.
 void copy_to_struct(std::span<const std::uint8_t> frame, const CopyPlan& plan, std::byte* base) noexcept;
+void copy_to_frame(std::span<std::uint8_t> frame, const CopyPlan& plan, const std::byte* base) noexcept;
 
 // The implementations behind the two, picked once by CPU; exposed for the tests.
 

@@ -164,6 +164,22 @@ std::uint64_t selection_key(std::span<const std::uint8_t> frame) {
   return key;
 }
 
+/// Checks what `encode` refuses and writes the header. Returns the bytes the CRC will cover, or 0
+/// with `error` set.
+std::size_t begin_encode(std::uint8_t packet_number, const Selection& selection, const void* base,
+                         const FieldLayout& layout, std::span<std::uint8_t> out, FrameError& error) {
+  const std::uint16_t length = selection.data_bytes();
+  if (!check_encodable(packet_number, selection, kMinFrameBytes + length, out.size(), error)) return 0;
+  if (!check_values(selection, base, layout, error)) return 0;
+  return write_header(packet_number, selection, length, out) + length;
+}
+
+/// Writes the trailer after the `covered` bytes; returns the frame's size.
+std::size_t finish_encode(std::span<std::uint8_t> out, std::size_t covered, std::uint32_t crc) {
+  write_u32(out.data() + covered, crc);
+  return covered + kCrcBytes;
+}
+
 void zero_fills(const CopyPlan& plan, void* base) {
   for (const ByteFill& fill : plan.fills())
     std::memset(static_cast<std::byte*>(base) + fill.begin, 0, fill.size);
@@ -252,9 +268,16 @@ void copy_fields(const FrameView& frame, void* base, const FieldLayout& layout) 
   zero_fills(plan, base);
 }
 
+// Two passes (copy, then CRC) with a plan built for the call: for tools and tests, and the
+// reference FrameCodec's stitched encoder is tested against.
 EncodeResult encode(std::uint8_t packet_number, const Selection& selection, const void* base,
                     const FieldLayout& layout, std::span<std::uint8_t> out) noexcept {
-  return FrameCodec(layout).encode(packet_number, selection, base, out);
+  EncodeResult result;
+  const std::size_t covered = begin_encode(packet_number, selection, base, layout, out, result.error);
+  if (covered == 0) return result;
+  detail::copy_to_frame(out, CopyPlan(selection, layout), static_cast<const std::byte*>(base));
+  result.size = finish_encode(out, covered, crc32(out.first(covered)));
+  return result;
 }
 
 FrameCodec::FrameCodec(const FieldLayout& layout) noexcept
@@ -285,16 +308,11 @@ DecodeResult FrameCodec::decode(std::span<const std::uint8_t> bytes, void* base)
 EncodeResult FrameCodec::encode(std::uint8_t packet_number, const Selection& selection, const void* base,
                                 std::span<std::uint8_t> out) noexcept {
   EncodeResult result;
-  const std::uint16_t length = selection.data_bytes();
-  const std::size_t size = kMinFrameBytes + length;
-  if (!check_encodable(packet_number, selection, size, out.size(), result.error)) return result;
-  if (!check_values(selection, base, *layout_, result.error)) return result;
-  write_header(packet_number, selection, length, out);
-  const std::uint32_t crc =
-      detail::gather_crc32(out.first(kHeaderBytes + length), plan_for(selection, selection_key(selection)),
-                           static_cast<const std::byte*>(base));
-  write_u32(out.data() + kHeaderBytes + length, crc);
-  result.size = size;
+  const std::size_t covered = begin_encode(packet_number, selection, base, *layout_, out, result.error);
+  if (covered == 0) return result;
+  const std::uint32_t crc = detail::gather_crc32(
+      out.first(covered), plan_for(selection, selection_key(selection)), static_cast<const std::byte*>(base));
+  result.size = finish_encode(out, covered, crc);
   return result;
 }
 
