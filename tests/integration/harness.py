@@ -13,6 +13,7 @@ import socket
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -89,12 +90,12 @@ class Harness:
             sys.exit(SKIP)
         return str(path)
 
-    def start(self, label, argv):
+    def start(self, label, argv, stdin=None):
         """Starts a child with stdout and stderr in files of the scratch directory."""
         stdout = open(self.dir / f"{label}.out", "wb")
         stderr = open(self.dir / f"{label}.err", "wb")
-        print(f"[{self.name}] start {label}: {' '.join(argv)}", flush=True)
-        process = subprocess.Popen(argv, stdout=stdout, stderr=stderr)
+        print(f"[{self.name}] start {label}: {' '.join(map(str, argv))}", flush=True)
+        process = subprocess.Popen(argv, stdin=stdin, stdout=stdout, stderr=stderr)
         self.children.append((label, process))
         return process
 
@@ -119,6 +120,18 @@ class Harness:
 
     def output(self, label):
         return self.dir / f"{label}.out"
+
+    def secure_profiles(self):
+        """A fresh test PKI, and a directory with rsg's profiles and the PKI's participant profiles
+        (rsg_secure_gateway, _reader, _intruder, _commander), as the README tells operators to make."""
+        source = Path(__file__).resolve().parents[2] / "xml_profiles"
+        pki = self.dir / "pki"
+        subprocess.run([source / "security/make_test_pki.sh", pki], check=True, stdout=subprocess.DEVNULL)
+        profiles = self.dir / "profiles"
+        profiles.mkdir()
+        for file in [*sorted(source.glob("*.xml")), pki / "rsg_secure_profiles.xml"]:
+            (profiles / file.name).write_bytes(file.read_bytes())
+        return profiles
 
     def gateway(self, label, *flags):
         stats = self.dir / f"{label}.stats.json"
@@ -167,3 +180,32 @@ def main(name, body):
 def wait_for_stats(stats_path, predicate, what, timeout_s=DEFAULT_WAIT_S):
     """Waits until the gateway's --stats-file satisfies `predicate`; returns the stats."""
     return wait_for(lambda: (lambda s: s if s and predicate(s) else None)(read_json(stats_path)), what, timeout_s)
+
+
+class UdpRelay(threading.Thread):
+    """Receives on `port`, records every datagram, forwards it to `forward_to` (when given)."""
+
+    def __init__(self, port, forward_to=None):
+        super().__init__(daemon=True)
+        self.socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4 << 20)
+        self.socket.bind(("127.0.0.1", port))
+        self.socket.settimeout(0.2)
+        self.forward_to = forward_to
+        self.datagrams = []
+        self.stopping = False
+
+    def run(self):
+        while not self.stopping:
+            try:
+                datagram, _ = self.socket.recvfrom(65536)
+            except socket.timeout:
+                continue
+            self.datagrams.append(datagram)
+            if self.forward_to:
+                self.socket.sendto(datagram, self.forward_to)
+
+    def stop(self):
+        self.stopping = True
+        self.join()
+        self.socket.close()

@@ -1,43 +1,12 @@
 """raw -> DDS -> raw through two gateways (ingress on one, egress on the other): every frame
 comes out byte-identical. A tap between the sim and the first gateway records the bytes sent."""
 
-import socket
 import sys
-import threading
 
-from harness import check, main, wait_for, wait_for_stats, free_udp_port
+from harness import UdpRelay, check, main, wait_for, wait_for_stats, free_udp_port
 
 COUNT = 600
 RATE = "300"
-
-
-class UdpRelay(threading.Thread):
-    """Receives on `port`, records every datagram, forwards it to `forward_to` (when given)."""
-
-    def __init__(self, port, forward_to=None):
-        super().__init__(daemon=True)
-        self.socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        self.socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4 << 20)
-        self.socket.bind(("127.0.0.1", port))
-        self.socket.settimeout(0.2)
-        self.forward_to = forward_to
-        self.datagrams = []
-        self.stopping = False
-
-    def run(self):
-        while not self.stopping:
-            try:
-                datagram, _ = self.socket.recvfrom(65536)
-            except socket.timeout:
-                continue
-            self.datagrams.append(datagram)
-            if self.forward_to:
-                self.socket.sendto(datagram, self.forward_to)
-
-    def stop(self):
-        self.stopping = True
-        self.join()
-        self.socket.close()
 
 
 def body(h):

@@ -2,31 +2,16 @@
 participant profiles. The authenticated, permitted reader gets every frame exactly; a plain
 rsg_echo on the same domain, started first, is never matched and prints nothing."""
 
-import subprocess
 import sys
-from pathlib import Path
 
 from harness import check, main, read_json, read_json_lines, wait_for_stats, free_udp_port
 
 COUNT = 200
 RATE = "200"
-SOURCE = Path(__file__).resolve().parents[2]
-
-
-def secure_profiles(h):
-    """A directory with rsg's profiles and the test PKI's, as the README tells operators to make."""
-    pki = h.dir / "pki"
-    subprocess.run([SOURCE / "xml_profiles/security/make_test_pki.sh", pki], check=True,
-                   stdout=subprocess.DEVNULL)
-    profiles = h.dir / "profiles"
-    profiles.mkdir()
-    for source in [*sorted((SOURCE / "xml_profiles").glob("*.xml")), pki / "rsg_secure_profiles.xml"]:
-        (profiles / source.name).write_bytes(source.read_bytes())
-    return profiles
 
 
 def body(h):
-    profiles = secure_profiles(h)
+    profiles = h.secure_profiles()
     port = free_udp_port()
     gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--profiles", str(profiles),
                                "--participant-profile", "rsg_secure_gateway")

@@ -25,6 +25,7 @@
 #include <CLI/CLI.hpp>
 #include <array>
 #include <bit>
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -43,6 +44,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "random_state.hpp"
@@ -62,8 +64,6 @@ namespace rtps = eprosima::fastrtps::rtps;
 constexpr std::uint64_t kMarkerBits = 0x4B41454C2D475352;
 constexpr double kMarker = std::bit_cast<double>(kMarkerBits);
 
-constexpr const char* kTopic = "robot_state";
-
 struct Options {
   std::vector<std::string> profile_files;
   std::string profile;
@@ -72,6 +72,8 @@ struct Options {
   std::uint64_t seed = 1;
   bool marker = false;
   std::string partition;  ///< empty: the default partition
+  std::string topic = "robot_state";
+  bool wait_for_reader = false;  ///< publish: write only once a reader matched (for volatile readers)
 };
 
 std::vector<std::string> partitions(const Options& options) {
@@ -225,6 +227,15 @@ fdds::DataWriterQos writer_qos(fdds::Publisher& publisher, std::size_t samples) 
   return qos;
 }
 
+/// Bounded: a reader that never comes is the test's to report, from what the reader did not get.
+void wait_for_a_reader(fdds::DataWriter& writer) {
+  fdds::PublicationMatchedStatus matched;
+  for (int i = 0; i < 600 && matched.current_count == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    writer.get_publication_matched_status(matched);
+  }
+}
+
 fdds::DataReaderQos reader_qos(fdds::Subscriber& subscriber) {
   fdds::DataReaderQos qos = subscriber.get_default_datareader_qos();
   qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
@@ -268,7 +279,7 @@ void run(const Options& options, bool publishing) {
 
   Participant participant(options.domain, options.profile);
   enable_with_listener(participant, participant_events);
-  fdds::Topic* topic = participant.robot_state_topic(kTopic);
+  fdds::Topic* topic = participant.robot_state_topic(options.topic);
 
   bool endpoint_created = false;
   if (publishing) {
@@ -277,6 +288,7 @@ void run(const Options& options, bool publishing) {
         publisher->create_datawriter(topic, writer_qos(*publisher, options.samples), &writer_events);
     if (writer != nullptr) {
       endpoint_created = true;
+      if (options.wait_for_reader) wait_for_a_reader(*writer);
       RobotState sample;
       for (const StateValues& values : samples) {
         to_sample(values, sample);
@@ -323,12 +335,15 @@ int main(int argc, char** argv) {
     command.add_option("--seed", options.seed, "seed of the samples' values")->capture_default_str();
     command.add_flag("--marker", options.marker, "every double is the marker pattern");
     command.add_option("--partition", options.partition, "DDS partition (default: the default partition)");
+    command.add_option("--topic", options.topic, "RobotState topic")->capture_default_str();
   };
   CLI::App* publish = app.add_subcommand("publish", "write the samples, then wait for stdin to close");
   CLI::App* subscribe =
       app.add_subcommand("subscribe", "check the samples as they arrive until stdin closes");
   add_options(*publish);
   add_options(*subscribe);
+  publish->add_flag("--wait-for-reader", options.wait_for_reader,
+                    "write only once a reader matched (up to 60 s), for volatile readers");
   CLI11_PARSE(app, argc, argv);
 
   log_fast_dds_to_stderr();

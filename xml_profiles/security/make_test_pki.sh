@@ -5,11 +5,12 @@
 #
 # OUT_DIR receives
 #   ca.pem, ca.key                    a test CA (ECDSA P-256), for identities and permissions
-#   {gateway,reader,intruder}.pem/.key   identity certificates and private keys
+#   {gateway,reader,intruder,commander}.pem/.key   identity certificates and private keys
 #   governance.p7s                    governance.xml signed by the CA
 #   permissions_<identity>.p7s        permissions_<identity>.xml.in filled in and signed
-#   rsg_secure_profiles.xml           participant profiles rsg_secure_gateway, rsg_secure_reader
-#                                     and rsg_secure_intruder, pointing at the files above
+#   rsg_secure_profiles.xml           participant profiles rsg_secure_gateway, rsg_secure_reader,
+#                                     rsg_secure_intruder and rsg_secure_commander (may write
+#                                     the egress topic rsg_egress), pointing at the files above
 #
 # --udp-only makes the profiles use UDPv4 alone, without shared memory, so that all traffic
 # crosses a network interface (the security tests capture it there).
@@ -18,7 +19,7 @@
 # see docs/security.md.
 set -euo pipefail
 
-readonly IDENTITIES=(gateway reader intruder)
+readonly IDENTITIES=(gateway reader intruder commander)
 readonly VALID_DAYS=3650
 TEMPLATES="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd -P)"
 readonly TEMPLATES
