@@ -90,7 +90,8 @@ const std::array kKeys = {
               }},
     ConfigKey{"status-topic", "Topic of the GatewayStatus samples", &GatewayConfig::status_topic,
               [](const GatewayConfig& c) { return check_not_empty(c.status_topic); }},
-    ConfigKey{"expected-rate", "Nominal frame rate, Hz (the link is down after 10 silent periods)",
+    ConfigKey{"expected-rate",
+              "Nominal frame rate, Hz (the link is down after 10 silent periods, at least 10 ms)",
               &GatewayConfig::expected_rate,
               [](const GatewayConfig& c) {
                 return c.expected_rate >= 0.1 && c.expected_rate <= 100000 ? std::string()

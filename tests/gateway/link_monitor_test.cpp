@@ -41,6 +41,13 @@ TEST(LinkMonitor, GoesDownOnceAfterTenSilentPeriods) {
   EXPECT_TRUE(link.on_frame(kStart + milliseconds(60)));
 }
 
+TEST(LinkMonitor, NeverGoesDownAfterLessThanTenMilliseconds) {
+  LinkMonitor link(std::chrono::microseconds(200));  // 5 kHz: ten periods would be 2 ms
+  link.on_frame(kStart);
+  EXPECT_FALSE(link.poll(kStart + milliseconds(5)));
+  EXPECT_TRUE(link.poll(kStart + LinkMonitor::kMinSilence));
+}
+
 TEST(LinkMonitor, SilenceLimitFollowsTheNominalRate) {
   LinkMonitor link(milliseconds(10), 10);  // 100 Hz
   link.on_frame(kStart);

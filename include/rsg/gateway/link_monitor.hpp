@@ -1,10 +1,14 @@
 // Whether the robot is streaming: the link is up from the first valid frame and goes down after
-// `silent_periods` nominal frame periods without one.
+// `silent_periods` nominal frame periods without one, and never after less than kMinSilence:
+// above ~1 kHz, ten periods are shorter than the scheduling hiccups of a loaded host, and the
+// link flapped at 5 kHz.
 //
 // Silence produces no event, so the owner must call `poll()` by `deadline()` at the latest
 // (typically as the timeout of its receive call), not only when frames arrive.
 #pragma once
 
+#include <algorithm>
+#include <chrono>
 #include <cstdint>
 
 #include "rsg/gateway/clock.hpp"
@@ -14,9 +18,10 @@ namespace rsg::gateway {
 class LinkMonitor {
  public:
   static constexpr unsigned kDefaultSilentPeriods = 10;
+  static constexpr Clock::duration kMinSilence = std::chrono::milliseconds(10);
 
   explicit LinkMonitor(Clock::duration nominal_period, unsigned silent_periods = kDefaultSilentPeriods)
-      : silence_limit_(nominal_period * silent_periods) {}
+      : silence_limit_(std::max<Clock::duration>(nominal_period * silent_periods, kMinSilence)) {}
 
   /// A valid frame arrived. True when it brought the link up.
   bool on_frame(Clock::time_point now) {
