@@ -12,6 +12,7 @@
 #include <memory>
 #include <numeric>
 #include <random>
+#include <set>
 #include <vector>
 
 #include "crc32_copy.hpp"
@@ -157,26 +158,33 @@ TEST_F(StitchedKernel, GatherMatchesMemcpyAndIsal) {
   }
 }
 
-TEST_F(StitchedKernel, EveryFrameLengthAndPadding) {
-  // A contiguous layout with the full selection, cut short: every length the kernel takes, so every
-  // head padding 0..63 and every way the frame's first four bytes fall across the first chunks.
+TEST_F(StitchedKernel, EveryHeadPaddingASelectionCanHave) {
+  // The padding in front of the first chunk is 64 minus the frame's length mod 64, so it follows
+  // the selection. Field sizes are multiples of 8 plus the 5-, 5- and 1-byte fields, so not every
+  // padding occurs; visit each one that does, with paddings 61 and 62, where the frame's first four
+  // bytes (the inverted start of the CRC) straddle the first two chunks, among them.
   std::mt19937_64 rng(3);
-  std::vector<std::uint8_t> frame(kMaxFrameBytes);
-  for (std::uint8_t& byte : frame) byte = static_cast<std::uint8_t>(rng());
-  StateValues values;
-  for (std::size_t size = 256; size <= kMaxFrameBytes; ++size) {
-    // A selection whose frame is `size` bytes does not exist for every size; the kernel itself
-    // works on any plan whose padding fits, which is what this checks, with the plan's moves unused.
-    const ChunkedCopyPlan plan(Selection{}, StateValues::layout());
+  std::array<std::uint8_t, kMaxFrameBytes> frame{};
+  std::set<std::size_t> paddings;
+  for (int round = 0; round < 200'000; ++round) {
+    const Selection selection = random_selection(rng);
+    const ChunkedCopyPlan plan(selection, StateValues::layout());
+    const std::size_t size = plan.plan().covered_bytes();
+    if (size < 256 || !paddings.insert(plan.head_padding()).second) continue;
+
     const std::span covered = std::span(frame).first(size);
-    if ((size + plan.head_padding()) % kChunkBytes != 0) {
-      EXPECT_EQ(detail::crc32_scatter_stitched(covered, plan, static_cast<std::byte*>(values.storage())),
-                crc32(covered));  // falls back to the plain path
-      continue;
-    }
-    EXPECT_EQ(detail::crc32_scatter_stitched(covered, plan, static_cast<std::byte*>(values.storage())),
-              crc32(covered));
+    for (std::uint8_t& byte : covered) byte = static_cast<std::uint8_t>(rng());
+    StateValues expected;
+    StateValues actual;
+    EXPECT_EQ(detail::crc32_scatter_stitched(covered, plan, static_cast<std::byte*>(actual.storage())),
+              crc32(covered))
+        << "padding " << plan.head_padding();
+    detail::copy_to_struct(covered, plan.plan(), static_cast<std::byte*>(expected.storage()));
+    EXPECT_EQ(std::memcmp(actual.storage(), expected.storage(), StateValues::storage_size()), 0)
+        << "padding " << plan.head_padding();
   }
+  EXPECT_TRUE(paddings.contains(61) && paddings.contains(62));
+  EXPECT_EQ(paddings.size(), 48U);  // 6 of the 8 residues mod 8, times 8
 }
 
 TEST(CopyPlan, FullSelectionIsAFewMovesAndLeavesOnlyErrorSetHighBytes) {
