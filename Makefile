@@ -9,12 +9,17 @@ FUZZ_SECONDS ?= 30
 # (~RTPSReader, 64 vs 56 bytes); that report is about the library, not about rsg.
 ASAN_OPTIONS ?= new_delete_type_mismatch=0
 PACKAGES   := $(shell grep -v '^\s*\#' docker/packages.txt)
+# ccache (in docker/packages.txt) makes the three builds of `make test` and a rebuild after a
+# branch switch cheap; paths are taken relative to the checkout so clones share the cache.
+CCACHE     := -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache
+export CCACHE_BASEDIR := $(CURDIR)
+export CCACHE_NOHASHDIR := true
 SUDO       := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # pipefail: a test run piped through tee must still fail the target.
 SHELL      := /bin/bash
 .SHELLFLAGS := -o pipefail -c
 
-.PHONY: all deps build test unit-asan fuzz fuzz-build demo bench format clean
+.PHONY: all deps build install test unit-asan fuzz fuzz-build demo bench format clean wireshark-plugin
 
 all: build
 
@@ -23,22 +28,35 @@ deps:
 	  dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
 	  echo "make deps: installing" $$missing; \
+	  echo 'wireshark-common wireshark-common/install-setuid boolean false' | $(SUDO) debconf-set-selections; \
 	  $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
+	@# Node and npm for the tests that read MCAP files with @mcap/core (Debian's, unless a node is there).
+	@command -v npm >/dev/null || { $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends nodejs npm; }
+	@[ tests/record/package-lock.json -ot tests/record/node_modules/.package-lock.json ] || \
+	  npm ci --prefix tests/record --no-audit --no-fund
+	@[ tests/view/package-lock.json -ot tests/view/node_modules/.package-lock.json ] || \
+	  npm ci --prefix tests/view --no-audit --no-fund
 
 build: deps
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CCACHE)
 	cmake --build $(BUILD) -j $(JOBS)
+
+# Tools, profiles, IDL, client libraries and headers, and the CMake package (find_package(rsg)).
+# PREFIX defaults to CMake's (/usr/local): make install PREFIX=/opt/rsg
+install: build
+	cmake --install $(BUILD) $(if $(PREFIX),--prefix $(PREFIX))
 
 # Unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer.
 unit-asan: deps
-	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DRSG_SANITIZE=ON
+	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DRSG_SANITIZE=ON $(CCACHE)
 	cmake --build $(ASAN_BUILD) -j $(JOBS) --target unit_tests
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) ctest --output-on-failure -L unit 2>&1 | tee ctest.log
 
 fuzz-build: deps
-	CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_BUILD) -DRSG_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo
+	CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_BUILD) -DRSG_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CCACHE)
 	cmake --build $(FUZZ_BUILD) -j $(JOBS)
 
 # Each fuzzer for FUZZ_SECONDS (make fuzz FUZZ_SECONDS=600 for a long run).
@@ -57,6 +75,13 @@ demo: build
 
 bench: build
 	tests/bench/run_bench.sh $(BUILD)
+
+# The SEND_BUF dissector into Wireshark's personal Lua plugins folder (where `tshark -G folders` says).
+wireshark-plugin:
+	@dir=$$(tshark -G folders 2>/dev/null | sed -n 's/^Personal Lua Plugins:[[:space:]]*//p'); \
+	dir=$${dir:-$$HOME/.local/lib/wireshark/plugins}; \
+	mkdir -p "$$dir" && install -m 644 tools/wireshark/rsg_sendbuf.lua "$$dir/" && \
+	echo "installed $$dir/rsg_sendbuf.lua: restart Wireshark, then filter on sendbuf"
 
 format:
 	git ls-files '*.cpp' '*.hpp' '*.h' '*.c' | xargs clang-format -i

@@ -1,7 +1,8 @@
-#include "rsg/participant.hpp"
+#include "rsg/dds/participant.hpp"
 
 #include <RobotStatePubSubTypes.h>
 #include <RobotStateTypeObject.h>
+#include <fastrtps/types/TypeObjectFactory.h>
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <stdexcept>
@@ -16,6 +17,28 @@ Participant::Participant(int domain, const std::string& profile) {
     throw std::runtime_error("cannot create DDS participant on domain " + std::to_string(domain) +
                              " with profile '" + profile + "' (are the XML profiles loaded?)");
 }
+
+namespace {
+
+fdds::DomainParticipantQos profile_qos(const std::string& profile) {
+  fdds::DomainParticipantQos qos;
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  if (profile.empty()) return factory->get_default_participant_qos();
+  if (factory->get_participant_qos_from_profile(profile, qos) != ReturnCode_t::RETCODE_OK)
+    throw std::runtime_error("no participant profile named '" + profile + "' (are the XML profiles loaded?)");
+  return qos;
+}
+
+fdds::DomainParticipantQos with_discovery(fdds::DomainParticipantQos qos, int domain,
+                                          const DiscoveryOptions& discovery) {
+  apply_discovery(discovery, domain, qos);
+  return qos;
+}
+
+}  // namespace
+
+Participant::Participant(int domain, const std::string& profile, const DiscoveryOptions& discovery)
+    : Participant(domain, with_discovery(profile_qos(profile), domain, discovery)) {}
 
 Participant::Participant(int domain, const fdds::DomainParticipantQos& qos) {
   participant_ = fdds::DomainParticipantFactory::get_instance()->create_participant(domain, qos);
@@ -39,9 +62,17 @@ fdds::Topic* Participant::topic(const std::string& name, fdds::TypeSupport type)
   return created;
 }
 
-fdds::Topic* Participant::robot_state_topic(const std::string& name) {
+fdds::Topic* Participant::robot_state_topic(const std::string& name, const std::string& type_name) {
   registerRobotStateTypes();  // the type object the DDS-SQL filter factory looks members up in
-  return topic(name, fdds::TypeSupport(new RobotStatePubSubType()));
+  fdds::TypeSupport type(new RobotStatePubSubType());
+  if (!type_name.empty()) {
+    // The filter factory looks the type object up by the topic's type name.
+    auto* factory = eprosima::fastrtps::types::TypeObjectFactory::get_instance();
+    factory->add_type_object(type_name, rsg::GetRobotStateIdentifier(true), rsg::GetRobotStateObject(true));
+    factory->add_type_object(type_name, rsg::GetRobotStateIdentifier(false), rsg::GetRobotStateObject(false));
+    type->setName(type_name.c_str());
+  }
+  return topic(name, type);
 }
 
 fdds::Publisher* Participant::publisher(const std::vector<std::string>& partitions) {

@@ -1,4 +1,4 @@
-#include "rsg/profiles.hpp"
+#include "rsg/dds/profiles.hpp"
 
 #include <unistd.h>
 
@@ -27,7 +27,11 @@ std::filesystem::path default_profiles_dir() {
     std::error_code error;
     if (std::filesystem::is_directory(candidate, error)) return std::filesystem::weakly_canonical(candidate);
   }
-  return RSG_DEFAULT_PROFILES_DIR;  // a build tree: the sources it was built from
+  // A build tree uses the sources it was built from; a program linking the installed library, the
+  // profiles installed with it.
+  std::error_code error;
+  if (std::filesystem::is_directory(RSG_SOURCE_PROFILES_DIR, error)) return RSG_SOURCE_PROFILES_DIR;
+  return RSG_INSTALLED_PROFILES_DIR;
 }
 
 void load_profiles(const std::filesystem::path& file_or_dir) {
@@ -46,6 +50,15 @@ void load_profiles(const std::filesystem::path& file_or_dir) {
     if (factory->load_XML_profiles_file(file.string()) != ReturnCode_t::RETCODE_OK)
       throw std::runtime_error(file.string() +
                                ": Fast DDS rejected this XML profile file (its log above says where)");
+}
+
+void load_profiles(const std::vector<std::string>& files_or_dirs, const std::string& participant_profile) {
+  if (files_or_dirs.empty()) load_profiles(default_profiles_dir());
+  for (const auto& file_or_dir : files_or_dirs) load_profiles(file_or_dir);
+  eprosima::fastdds::dds::DomainParticipantQos unused;
+  if (eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
+          participant_profile, unused) != ReturnCode_t::RETCODE_OK)
+    throw std::runtime_error("no participant profile named '" + participant_profile + "'");
 }
 
 }  // namespace rsg

@@ -1,4 +1,4 @@
-#include "rsg/robot_state.hpp"
+#include "rsg/dds/robot_state.hpp"
 
 #include <cstring>
 #include <type_traits>

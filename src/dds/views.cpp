@@ -1,11 +1,11 @@
-#include "rsg/views.hpp"
+#include "rsg/dds/views.hpp"
 
 #include <fastdds/rtps/attributes/PropertyPolicy.h>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 
-#include "rsg/field_table.hpp"
-#include "rsg/selection.hpp"
+#include "rsg/wire/field_table.hpp"
+#include "rsg/wire/selection.hpp"
 
 namespace rsg {
 namespace {

@@ -1,4 +1,4 @@
-#include "rsg/gateway/config.hpp"
+#include "config.hpp"
 
 #include <sched.h>
 #include <yaml-cpp/yaml.h>
@@ -7,7 +7,8 @@
 #include <charconv>
 #include <set>
 
-#include "rsg/gateway/source_filter.hpp"
+#include "rsg/dds/ros2.hpp"
+#include "source_filter.hpp"
 
 namespace rsg::gateway {
 namespace {
@@ -38,6 +39,42 @@ std::string check_optional_host_port(const std::string& value) {
 
 std::string check_not_empty(const std::string& value) { return value.empty() ? "must not be empty" : ""; }
 
+// "[ID@]HOST:PORT" (rsg/dds/discovery.hpp; kept here in syntax only so that the configuration
+// needs no DDS to be checked, nor to be fuzzed).
+std::string check_discovery_server(const std::string& value) {
+  const std::size_t at = value.find('@');
+  if (at == std::string::npos) return check_host_port(value, false);
+  unsigned id = 0;
+  const auto [end, status] = std::from_chars(value.data(), value.data() + at, id);
+  if (at == 0 || status != std::errc() || end != value.data() + at || id > 255)
+    return "'" + value + "': server id before '@' must be 0..255";
+  return check_host_port(value.substr(at + 1), false);
+}
+
+// "HOST" or "HOST:PORT".
+std::string check_peer(const std::string& value) {
+  if (value.empty()) return "a peer must not be empty";
+  return value.find(':') == std::string::npos ? std::string() : check_host_port(value, false);
+}
+
+std::string check_each(const std::vector<std::string>& values, std::string (*check)(const std::string&)) {
+  for (const auto& value : values)
+    if (auto error = check(value); !error.empty()) return error;
+  return {};
+}
+
+std::string check_decimation(const std::string& value) {
+  return value.empty() || parse_decimation(value)
+             ? std::string()
+             : "'" + value + "' is not HZ (in (0, 10000]) or every:N (N in 1..1000000)";
+}
+
+std::string check_frame(const std::string& value) {
+  return value.empty()            ? "must not be empty"
+         : value.starts_with('/') ? "TF frame ids do not start with '/'"
+                                  : "";
+}
+
 const std::array kKeys = {
     ConfigKey{"listen", "Receive raw frames on HOST:PORT (UDP) and publish them", &GatewayConfig::listen,
               [](const GatewayConfig& c) { return c.listen.empty() ? "" : check_host_port(c.listen, true); }},
@@ -60,6 +97,16 @@ const std::array kKeys = {
     ConfigKey{
         "receive-buffer", "Kernel UDP receive buffer, bytes", &GatewayConfig::receive_buffer,
         [](const GatewayConfig& c) { return c.receive_buffer >= 0 ? "" : std::string("must be >= 0"); }},
+    ConfigKey{
+        "rate-topic",
+        "Also publish the state on NAME at most HZ times a second, e.g. robot_state_50hz:50 (repeatable; "
+        "paced by the robot's time when frames carry it, else by arrival)",
+        &GatewayConfig::rate_topics,
+        [](const GatewayConfig& c) {
+          for (const auto& value : c.rate_topics)
+            if (!parse_rate_topic(value)) return "'" + value + "' is not NAME:HZ with HZ in (0, 10000]";
+          return std::string();
+        }},
     ConfigKey{"egress-topic", "Send the samples of this topic as raw frames to --send-to",
               &GatewayConfig::egress_topic, [](const GatewayConfig&) { return std::string(); }},
     ConfigKey{"send-to", "Destination HOST:PORT of egress frames (repeatable)", &GatewayConfig::send_to,
@@ -104,6 +151,15 @@ const std::array kKeys = {
               }},
     ConfigKey{"stats-file", "Keep the counters as JSON in this file (rewritten every second and at exit)",
               &GatewayConfig::stats_file, [](const GatewayConfig&) { return std::string(); }},
+    ConfigKey{"pcap-ring",
+              "Flight recorder: keep the last SECONDS of raw datagrams in memory and write them as a pcap "
+              "file into --pcap-dir on SIGUSR1 and when the link goes down; 0: off",
+              &GatewayConfig::pcap_ring,
+              [](const GatewayConfig& c) {
+                return c.pcap_ring >= 0 && c.pcap_ring <= 600 ? std::string() : "must be in 0..600";
+              }},
+    ConfigKey{"pcap-dir", "Directory the flight recorder's pcap files go to", &GatewayConfig::pcap_dir,
+              [](const GatewayConfig&) { return std::string(); }},
     ConfigKey{"log-level", "trace, debug, info, warn, error or off", &GatewayConfig::log_level,
               [](const GatewayConfig& c) {
                 static constexpr std::array kLevels = {"trace", "debug", "info", "warn", "error", "off"};
@@ -128,6 +184,52 @@ const std::array kKeys = {
                            ? std::string()
                            : "must be -1 or 0.." + std::to_string(CPU_SETSIZE - 1);
               }},
+    ConfigKey{"ros2",
+              "ROS 2 naming: publish on rt/<ros2-namespace>/<topic> (robot_state), gateway_status and take "
+              "egress from robot_state_cmd, with rsg_msgs type names, so ROS 2 nodes subscribe directly",
+              &GatewayConfig::ros2,
+              [](const GatewayConfig& c) {
+                return c.ros2 && !c.partition.empty()
+                           ? std::string(
+                                 "ROS 2 does not use partitions: drop --partition, use --ros2-namespace")
+                           : std::string();
+              }},
+    ConfigKey{"ros2-namespace", "ROS 2 namespace of the topics with --ros2, e.g. /robot1 (default: none)",
+              &GatewayConfig::ros2_namespace,
+              [](const GatewayConfig& c) {
+                if (!c.ros2_namespace.empty() && !c.ros2) return std::string("needs --ros2");
+                return check_ros2_namespace(c.ros2_namespace);
+              }},
+    ConfigKey{
+        "joint-states",
+        "Publish sensor_msgs/JointState (q, dq, tau_J) on joint_states (rt/<ros2-namespace>/joint_states "
+        "with --ros2) at RATE: HZ (at most, paced like --rate-topic) or every:N (every Nth frame with q)",
+        &GatewayConfig::joint_states,
+        [](const GatewayConfig& c) { return check_decimation(c.joint_states); }},
+    ConfigKey{"joint-names", "The 7 joint names of joint_states, joint 1 first", &GatewayConfig::joint_names,
+              [](const GatewayConfig& c) {
+                if (c.joint_names.size() != 7) return std::string("needs exactly 7 names");
+                for (const auto& name : c.joint_names)
+                  if (name.empty()) return std::string("names must not be empty");
+                return std::string();
+              }},
+    ConfigKey{
+        "tf",
+        "Publish tf2_msgs/TFMessage --base-frame -> --ee-frame from O_T_EE on tf (rt/tf with --ros2) at "
+        "RATE (as --joint-states; frames with O_T_EE)",
+        &GatewayConfig::tf, [](const GatewayConfig& c) { return check_decimation(c.tf); }},
+    ConfigKey{"base-frame", "TF parent frame: the robot's base O", &GatewayConfig::base_frame,
+              [](const GatewayConfig& c) { return check_frame(c.base_frame); }},
+    ConfigKey{"ee-frame", "TF child frame: the end effector of O_T_EE", &GatewayConfig::ee_frame,
+              [](const GatewayConfig& c) { return check_frame(c.ee_frame); }},
+    ConfigKey{"external-wrench",
+              "Publish geometry_msgs/WrenchStamped from O_F_ext_hat_K on external_wrench "
+              "(rt/<ros2-namespace>/external_wrench with --ros2) at RATE (as --joint-states; frames with it)",
+              &GatewayConfig::external_wrench,
+              [](const GatewayConfig& c) { return check_decimation(c.external_wrench); }},
+    ConfigKey{"wrench-frame", "frame_id of external_wrench (O_F_ext_hat_K is expressed in the base frame O)",
+              &GatewayConfig::wrench_frame,
+              [](const GatewayConfig& c) { return check_frame(c.wrench_frame); }},
     ConfigKey{"profiles", "Fast DDS XML profile file or directory (default: rsg's xml_profiles)",
               &GatewayConfig::profiles, [](const GatewayConfig&) { return std::string(); }},
     ConfigKey{"participant-profile", "XML participant profile", &GatewayConfig::participant_profile,
@@ -138,6 +240,16 @@ const std::array kKeys = {
               [](const GatewayConfig& c) { return check_not_empty(c.reader_profile); }},
     ConfigKey{"status-profile", "XML data writer profile of the status topic", &GatewayConfig::status_profile,
               [](const GatewayConfig& c) { return check_not_empty(c.status_profile); }},
+    ConfigKey{
+        "discovery-server",
+        "Find the other participants through this Fast DDS Discovery Server, [ID@]HOST:PORT (repeatable; "
+        "ID defaults to the position in the list, as `fastdds discovery -i ID`)",
+        &GatewayConfig::discovery_servers,
+        [](const GatewayConfig& c) { return check_each(c.discovery_servers, check_discovery_server); }},
+    ConfigKey{"peer",
+              "Send discovery announcements to this unicast peer instead of multicast, HOST[:PORT] "
+              "(repeatable; HOST alone covers participant ids 0..59)",
+              &GatewayConfig::peers, [](const GatewayConfig& c) { return check_each(c.peers, check_peer); }},
 };
 
 const ConfigKey* find_key(std::string_view name) {
@@ -201,6 +313,13 @@ std::string assign(GatewayConfig& config, const ConfigKey::Member& member, const
     std::string operator()(double GatewayConfig::*target) const {
       return node.IsScalar() ? read_number(node, config.*target) : "expected a number";
     }
+    std::string operator()(bool GatewayConfig::*target) const {
+      if (node.IsScalar() && (node.Scalar() == "true" || node.Scalar() == "false")) {
+        config.*target = node.Scalar() == "true";
+        return {};
+      }
+      return "expected true or false";
+    }
   };
   return std::visit(Visitor{config, node}, member);
 }
@@ -246,13 +365,49 @@ std::optional<std::string> check_config(const GatewayConfig& config) {
   if (!config.has_ingress() && !config.has_egress())
     return "nothing to do: give --listen (raw -> DDS) and/or --egress-topic with --send-to (DDS -> raw)";
   if (config.has_egress() && config.send_to.empty()) return "--egress-topic needs at least one --send-to";
-  if (!config.has_egress() && !config.send_to.empty()) return "--send-to needs --egress-topic";
+  if (!config.has_egress() && !config.send_to.empty()) return "--send-to needs --egress-topic (or --ros2)";
   if (config.requests_selection() && !config.has_ingress())
     return "--request-groups/--request-fields need --listen: the robot answers to the listening socket";
   if (!config.robot.empty() && !config.requests_selection())
     return "--robot needs --request-groups or --request-fields";
   if (!config.allow_from.empty() && !config.has_ingress()) return "--allow-from needs --listen";
+  if (config.pcap_ring > 0 && config.pcap_dir.empty()) return "--pcap-ring needs --pcap-dir";
+  if ((!config.joint_states.empty() || !config.tf.empty() || !config.external_wrench.empty()) &&
+      !config.has_ingress())
+    return "--joint-states/--tf/--external-wrench need --listen: they come from the received frames";
+  if (config.pcap_ring > 0 && !config.has_ingress())
+    return "--pcap-ring needs --listen: it records what arrives there";
   return std::nullopt;
+}
+
+std::optional<RateTopic> parse_rate_topic(const std::string& value) {
+  const std::size_t colon = value.rfind(':');
+  if (colon == std::string::npos || colon == 0) return std::nullopt;
+  RateTopic rate{value.substr(0, colon), 0};
+  const std::string_view hz = std::string_view(value).substr(colon + 1);
+  const auto [end, status] = std::from_chars(hz.data(), hz.data() + hz.size(), rate.hz);
+  if (hz.empty() || status != std::errc() || end != hz.data() + hz.size() ||
+      !(rate.hz > 0 && rate.hz <= 10000))
+    return std::nullopt;
+  return rate;
+}
+
+std::optional<Decimation> parse_decimation(const std::string& value) {
+  constexpr std::string_view kEvery = "every:";
+  if (value.starts_with(kEvery)) {
+    const std::string_view n = std::string_view(value).substr(kEvery.size());
+    std::uint32_t every = 0;
+    const auto [end, status] = std::from_chars(n.data(), n.data() + n.size(), every);
+    if (n.empty() || status != std::errc() || end != n.data() + n.size() || every < 1 || every > 1'000'000)
+      return std::nullopt;
+    return Decimation{every, {}};
+  }
+  double hz = 0;
+  const auto [end, status] = std::from_chars(value.data(), value.data() + value.size(), hz);
+  if (value.empty() || status != std::errc() || end != value.data() + value.size() ||
+      !(hz > 0 && hz <= 10000))
+    return std::nullopt;
+  return Decimation{0, std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / hz))};
 }
 
 Selection requested_selection(const GatewayConfig& config) {

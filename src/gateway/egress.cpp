@@ -6,7 +6,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <stdexcept>
 
-#include "rsg/robot_state.hpp"
+#include "rsg/dds/robot_state.hpp"
 
 namespace rsg::gateway {
 namespace {
@@ -21,7 +21,7 @@ Egress::Egress(Participant& participant, const Options& options) : participant_(
     destinations_.push_back({endpoint, UdpSocket::for_sending_to(endpoint)});
 
   subscriber_ = participant_.subscriber(options.partitions);
-  fdds::Topic* topic = participant_.robot_state_topic(options.topic);
+  fdds::Topic* topic = participant_.robot_state_topic(options.topic, options.type_name);
   reader_ = subscriber_->create_datareader_with_profile(topic, options.reader_profile);
   if (!reader_) {
     participant_.get()->delete_subscriber(subscriber_);

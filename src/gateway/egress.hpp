@@ -15,12 +15,12 @@
 #include <thread>
 #include <vector>
 
-#include "rsg/frame.hpp"
-#include "rsg/gateway/log_throttle.hpp"
-#include "rsg/gateway/stats.hpp"
-#include "rsg/participant.hpp"
-#include "rsg/robot_state.hpp"
-#include "rsg/udp_socket.hpp"
+#include "log_throttle.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/robot_state.hpp"
+#include "rsg/transport/udp_socket.hpp"
+#include "rsg/wire/frame.hpp"
+#include "stats.hpp"
 
 namespace rsg::gateway {
 
@@ -28,6 +28,7 @@ class Egress {
  public:
   struct Options {
     std::string topic;
+    std::string type_name;  ///< "" : rsg::RobotState; else e.g. rsg::kRos2RobotStateType
     std::vector<std::string> partitions;
     std::string reader_profile;
     std::vector<Endpoint> destinations;

@@ -14,7 +14,10 @@
 #include <stdexcept>
 #include <thread>
 
-#include "rsg/profiles.hpp"
+#include "realtime.hpp"
+#include "rsg/dds/discovery.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "rsg/dds/ros2.hpp"
 
 namespace rsg::gateway {
 namespace {
@@ -67,17 +70,55 @@ void load_and_check_profiles(const GatewayConfig& config) {
 // tests/reliability/test_gateway_restart.py. A participant id taken from the pid gives a restart
 // other ports (Fast DDS moves on to free ports if these are taken). 60 ids keep every domain's
 // ports below 65536. A profile that sets <participantID> itself is left alone.
-fdds::DomainParticipantQos participant_qos(const std::string& profile) {
+fdds::DomainParticipantQos participant_qos(const GatewayConfig& config) {
+  const std::string& profile = config.participant_profile;
   fdds::DomainParticipantQos qos;
   if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(profile, qos) !=
       ReturnCode_t::RETCODE_OK)
     throw std::runtime_error("no participant profile named '" + profile + "'");
   if (qos.wire_protocol().participant_id < 0) qos.wire_protocol().participant_id = ::getpid() % 60;
+  try {
+    apply_discovery({config.discovery_servers, config.peers}, config.domain, qos);
+  } catch (const std::invalid_argument& error) {
+    throw std::runtime_error(std::string("--discovery-server/--peer: ") + error.what());
+  }
   return qos;
 }
 
 std::vector<std::string> partitions_of(const GatewayConfig& config) {
   return config.partition.empty() ? std::vector<std::string>{} : std::vector<std::string>{config.partition};
+}
+
+// The DDS topic of a configured topic name: itself, or its ROS 2 name in the namespace.
+std::string dds_topic(const GatewayConfig& config, const std::string& name) {
+  return config.ros2 ? ros2_topic_name(config.ros2_namespace, name) : name;
+}
+
+std::string state_type_name(const GatewayConfig& config) {
+  return config.ros2 ? std::string(kRos2RobotStateType) : std::string();
+}
+
+std::string status_topic_of(const GatewayConfig& config) {
+  return config.ros2 ? ros2_topic_name(config.ros2_namespace, "gateway_status") : config.status_topic;
+}
+
+// joint_states and external_wrench in the namespace; tf absolute (/tf), where tf2 and RViz listen.
+std::optional<Ros2StandardTopics::Options> standard_topics_of(const GatewayConfig& config) {
+  Ros2StandardTopics::Options options;
+  const auto output = [&](const std::string& rate, const std::string& name) {
+    return rate.empty()
+               ? std::nullopt
+               : std::optional(Ros2StandardTopics::Output{*parse_decimation(rate), dds_topic(config, name)});
+  };
+  options.joint_states = output(config.joint_states, "joint_states");
+  options.tf = output(config.tf, config.ros2 ? "/tf" : "tf");
+  options.external_wrench = output(config.external_wrench, "external_wrench");
+  if (!options.any()) return std::nullopt;
+  options.joint_names = config.joint_names;
+  options.base_frame = config.base_frame;
+  options.ee_frame = config.ee_frame;
+  options.wrench_frame = config.wrench_frame;
+  return options;
 }
 
 }  // namespace
@@ -94,7 +135,14 @@ GatewaySetup prepare(const GatewayConfig& config) {
       std::string error;
       if (!ingress.sources.allow(network, error)) throw std::runtime_error("--allow-from: " + error);
     }
-    ingress.topic = config.topic;
+    ingress.topic = dds_topic(config, config.topic);
+    ingress.type_name = state_type_name(config);
+    for (const auto& value : config.rate_topics) {
+      const RateTopic rate = *parse_rate_topic(value);
+      ingress.rate_topics.push_back(
+          {dds_topic(config, rate.name), std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / rate.hz))});
+    }
+    ingress.standard_topics = standard_topics_of(config);
     ingress.partitions = partitions_of(config);
     ingress.writer_profile = config.writer_profile;
     ingress.nominal_period = std::chrono::duration_cast<Clock::duration>(
@@ -102,11 +150,19 @@ GatewaySetup prepare(const GatewayConfig& config) {
     ingress.restart_threshold_ms = static_cast<std::uint64_t>(config.restart_threshold_ms);
     if (config.requests_selection()) ingress.requested_selection = requested_selection(config);
     if (!config.robot.empty()) ingress.robot = resolve("robot", config.robot);
+    if (config.pcap_ring > 0) {
+      std::error_code error;
+      if (!std::filesystem::is_directory(config.pcap_dir, error))
+        throw std::runtime_error("--pcap-dir: '" + config.pcap_dir + "' is not a directory");
+      ingress.flight_recorder = FlightRecorder::Options{std::chrono::duration<double>(config.pcap_ring),
+                                                        config.expected_rate, config.pcap_dir};
+    }
     setup.ingress = std::move(ingress);
   }
   if (config.has_egress()) {
     Egress::Options egress;
-    egress.topic = config.egress_topic;
+    egress.topic = dds_topic(config, config.egress_topic.empty() ? "robot_state_cmd" : config.egress_topic);
+    egress.type_name = state_type_name(config);
     egress.partitions = partitions_of(config);
     egress.reader_profile = config.reader_profile;
     for (const auto& destination : config.send_to)
@@ -119,20 +175,27 @@ GatewaySetup prepare(const GatewayConfig& config) {
 
 Gateway::Gateway(const GatewaySetup& setup)
     : config_(setup.config),
-      participant_(config_.domain, participant_qos(config_.participant_profile)),
-      status_(participant_, config_.status_topic, partitions_of(config_), config_.status_profile) {
+      participant_(config_.domain, participant_qos(config_)),
+      status_(participant_, status_topic_of(config_), partitions_of(config_), config_.status_profile,
+              config_.ros2 ? std::string(kRos2GatewayStatusType) : std::string()) {
   if (setup.ingress) {
     ingress_.emplace(participant_, *setup.ingress);
     spdlog::info("ingress: frames on UDP {} -> topic '{}' (domain {})",
-                 ingress_->local_endpoint().to_string(), config_.topic, config_.domain);
+                 ingress_->local_endpoint().to_string(), setup.ingress->topic, config_.domain);
+    if (const auto& standard = setup.ingress->standard_topics) {
+      for (const auto& [output, rate] :
+           {std::pair{&standard->joint_states, &config_.joint_states}, std::pair{&standard->tf, &config_.tf},
+            std::pair{&standard->external_wrench, &config_.external_wrench}})
+        if (*output) spdlog::info("ROS 2 standard topic '{}' at {}", (*output)->topic, *rate);
+    }
   }
   if (setup.egress) {
     egress_.emplace(participant_, *setup.egress);
-    spdlog::info("egress: topic '{}' -> UDP {}", config_.egress_topic, fmt::join(config_.send_to, ", "));
+    spdlog::info("egress: topic '{}' -> UDP {}", setup.egress->topic, fmt::join(config_.send_to, ", "));
   }
 }
 
-void Gateway::run(const std::atomic<bool>& stop) {
+void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump) {
   const auto start = Clock::now();
   if (ingress_) ingress_->start(start);
   rate_.update(0, start);
@@ -152,6 +215,7 @@ void Gateway::run(const std::atomic<bool>& stop) {
 
     const auto now = Clock::now();
     if (ingress_ && ingress_->link_changed(now)) on_link_change();
+    if (dump != nullptr && dump->exchange(false)) dump_flight_recorder("signal");
     if (now >= next_status) {
       on_status_period(now);
       next_status = std::max(next_status + kStatusPeriod, now);  // after a stall, do not catch up
@@ -168,6 +232,20 @@ void Gateway::on_link_change() {
   const GatewayStats stats = snapshot();
   spdlog::info("link {} ({})", stats.link_up ? "up" : "down", stats.source);
   status_.publish(stats);  // now, not at the next period: readers act on link changes
+  if (!stats.link_up) dump_flight_recorder("link_down");
+}
+
+void Gateway::dump_flight_recorder(std::string_view reason) {
+  if (!ingress_ || !ingress_->has_flight_recorder()) {
+    if (reason == "signal") spdlog::warn("SIGUSR1: no flight recorder to dump (start with --pcap-ring)");
+    return;
+  }
+  try {
+    const auto dumped = ingress_->dump_flight_recorder(reason);
+    spdlog::info("flight recorder ({}): {} datagrams in {}", reason, dumped->frames, dumped->path.string());
+  } catch (const std::exception& error) {
+    spdlog::error("flight recorder ({}): {}", reason, error.what());
+  }
 }
 
 void Gateway::on_status_period(Clock::time_point now) {
@@ -193,6 +271,21 @@ GatewayStats Gateway::snapshot() const {
   }
   stats.rate_hz = stats.link_up ? rate_hz_ : 0.0;
   return stats;
+}
+
+void enter_realtime_mode(const GatewayConfig& config) {
+  const RealtimeRequest request{config.rt_priority, config.cpu};
+  if (!request.any()) return;
+  const RealtimeOutcome outcome = enter_realtime(request);
+  if (!outcome.problems.empty()) {
+    spdlog::warn("real-time mode degraded, running without what was refused: {}", outcome.problems);
+    return;
+  }
+  std::string done;
+  if (outcome.fifo) done += "SCHED_FIFO priority " + std::to_string(request.priority) + ", memory locked";
+  if (outcome.pinned)
+    done += (done.empty() ? "" : ", ") + std::string("on CPU ") + std::to_string(request.cpu);
+  spdlog::info("real-time mode: ingress thread {}", done);
 }
 
 void Gateway::write_stats_file(const GatewayStats& stats) const {

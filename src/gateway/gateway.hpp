@@ -8,10 +8,10 @@
 #include <atomic>
 #include <optional>
 
+#include "config.hpp"
 #include "egress.hpp"
 #include "ingress.hpp"
-#include "rsg/gateway/config.hpp"
-#include "rsg/gateway/link_monitor.hpp"
+#include "link_monitor.hpp"
 #include "status_publisher.hpp"
 
 namespace rsg::gateway {
@@ -32,11 +32,18 @@ class Gateway {
   /// Binds, creates the DDS entities and starts egress. Throws std::runtime_error / std::system_error.
   explicit Gateway(const GatewaySetup& setup);
 
-  /// Receives, publishes and reports until `stop` is set, then writes the final status.
-  void run(const std::atomic<bool>& stop);
+  /// Receives, publishes and reports until `stop` is set, then writes the final status. Whenever
+  /// `dump` (when given) is set, it clears it and writes the flight recorder's pcap file.
+  void run(const std::atomic<bool>& stop, std::atomic<bool>* dump = nullptr);
+
+  /// Where ingress receives frames; nothing when there is no ingress.
+  std::optional<Endpoint> ingress_endpoint() const {
+    return ingress_ ? std::optional(ingress_->local_endpoint()) : std::nullopt;
+  }
 
  private:
   void on_link_change();
+  void dump_flight_recorder(std::string_view reason);
   void on_status_period(Clock::time_point now);
   GatewayStats snapshot() const;
   void write_stats_file(const GatewayStats& stats) const;
@@ -50,5 +57,10 @@ class Gateway {
   double rate_hz_ = 0;
   Clock::time_point next_summary_{};
 };
+
+/// Puts the calling thread (the one that will call `Gateway::run`) in the configured real-time
+/// mode, logging what was refused. Call it once the Gateway exists: Fast DDS has created its
+/// threads by then, and they must not inherit the ingress thread's priority and CPU.
+void enter_realtime_mode(const GatewayConfig& config);
 
 }  // namespace rsg::gateway

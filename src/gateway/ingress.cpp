@@ -69,20 +69,48 @@ Ingress::Ingress(Participant& participant, Options options)
                    options_.receive_buffer);
   }
   if (options_.requested_selection) requester_.emplace(*options_.requested_selection);
+  if (options_.flight_recorder) {
+    recorder_.emplace(*options_.flight_recorder, socket_.local_endpoint(), batch_);
+    spdlog::info("flight recorder: the last {} s of datagrams ({} at most) for {}",
+                 options_.flight_recorder->window.count(), recorder_->capacity(),
+                 options_.flight_recorder->dir.string());
+  }
 
   publisher_ = participant_.publisher(options_.partitions);
-  fdds::Topic* topic = participant_.robot_state_topic(options_.topic);
+  fdds::Topic* topic = participant_.robot_state_topic(options_.topic, options_.type_name);
   writer_ = publisher_->create_datawriter_with_profile(topic, options_.writer_profile);
   if (!writer_) {
     participant_.get()->delete_publisher(publisher_);
     throw std::runtime_error("cannot create the RobotState writer with profile '" + options_.writer_profile +
                              "'");
   }
+  for (const auto& rate : options_.rate_topics) {
+    fdds::Topic* rate_topic = participant_.robot_state_topic(rate.topic, options_.type_name);
+    fdds::DataWriter* rate_writer =
+        publisher_->create_datawriter_with_profile(rate_topic, options_.writer_profile);
+    if (!rate_writer) {
+      publisher_->delete_contained_entities();
+      participant_.get()->delete_publisher(publisher_);
+      throw std::runtime_error("cannot create the writer of --rate-topic '" + rate.topic + "'");
+    }
+    rate_writers_.push_back({rate_writer, Decimator({0, rate.period})});
+  }
+  if (options_.standard_topics && options_.standard_topics->any()) {
+    try {
+      standard_topics_.emplace(participant_, *publisher_, *options_.standard_topics);
+    } catch (...) {
+      publisher_->delete_contained_entities();
+      participant_.get()->delete_publisher(publisher_);
+      throw;
+    }
+  }
   // Loans need a plain type; RobotState is one, but a profile could still make writes non-loanable.
   writer_loans_ = writer_->get_type()->is_plain();
 }
 
 Ingress::~Ingress() {
+  standard_topics_.reset();  // its thread writes until then
+  for (const RateWriter& rate : rate_writers_) publisher_->delete_datawriter(rate.writer);
   publisher_->delete_datawriter(writer_);
   participant_.get()->delete_publisher(publisher_);
 }
@@ -94,9 +122,11 @@ void Ingress::start(Clock::time_point now) {
 void Ingress::receive(std::chrono::milliseconds timeout) {
   if (!socket_.wait_readable(timeout)) return;
   for (std::size_t round = 0; round < kMaxBatchesPerWake; ++round) {
+    if (recorder_) recorder_->lend(batch_);
     const std::size_t received = socket_.receive_batch(batch_);
     // Every datagram of a batch was queued by now: one clock reading serves them all.
     const auto now = Clock::now();
+    if (recorder_ && received) recorder_->commit(batch_, received, std::chrono::system_clock::now());
     for (std::size_t i = 0; i < received; ++i) handle(batch_[i], now);
     if (received < batch_.capacity()) return;  // the queue was empty; the next poll waits for more
   }
@@ -122,7 +152,10 @@ void Ingress::handle(const DatagramBatch::Datagram& datagram, Clock::time_point 
   }
   // Decoded straight into the sample that gets written: the payload's one copy happens in the
   // same pass as the CRC check. A rejected frame's sample goes back unwritten.
-  SampleSlot slot(*writer_, writer_loans_, fallback_sample_);
+  // With an in-process consumer the frame is decoded into the preallocated sample, not a loan:
+  // loaning takes the writer's lock, which Fast DDS's event thread may hold, and the consumer
+  // must not wait for it. write() then copies the sample into the writer's history (~0.1 us).
+  SampleSlot slot(*writer_, writer_loans_ && !options_.on_sample, fallback_sample_);
   const DecodeResult decoded = codec_.decode(datagram.bytes, slot.sample());
   if (!decoded) {
     reject(decoded.error(), datagram.from);
@@ -130,16 +163,33 @@ void Ingress::handle(const DatagramBatch::Datagram& datagram, Clock::time_point 
   }
   const FrameView& frame = decoded.frame();
 
-  sequence_.observe(frame.packet_number(), frame_time(frame));
+  const std::optional<std::uint64_t> robot_time_ms = frame_time(frame);
+  sequence_.observe(frame.packet_number(), robot_time_ms);
   link_came_up_ |= link_.on_frame(now);
   source_ = datagram.from;
   if (requester_ && requester_->due(frame.selection(), now))
     request_selection(options_.robot ? *options_.robot : datagram.from, now);
 
+  if (options_.on_sample) options_.on_sample(slot.sample());
+  // Before the full-rate write, which hands a loaned sample over to the middleware. The slower
+  // outputs are paced by the robot's time when the frame carries it, else by arrival.
+  if (!rate_writers_.empty() || standard_topics_) {
+    const std::chrono::nanoseconds t =
+        robot_time_ms ? std::chrono::nanoseconds(std::chrono::milliseconds(*robot_time_ms))
+                      : std::chrono::nanoseconds(now.time_since_epoch());
+    if (!rate_writers_.empty()) write_rate_topics(slot.sample(), t);
+    if (standard_topics_) standard_topics_->offer(slot.sample(), frame.selection(), t);
+  }
   if (slot.write())
     ++counters_.published;
   else
     ++counters_.publish_failed;
+}
+
+void Ingress::write_rate_topics(const RobotState& sample, std::chrono::nanoseconds t) {
+  for (RateWriter& rate : rate_writers_)
+    if (rate.decimator.due(t))
+      rate.writer->write(const_cast<RobotState*>(&sample));  // a copy into the writer's own history
 }
 
 void Ingress::reject(const FrameError& error, const Endpoint& sender) {
@@ -160,6 +210,11 @@ void Ingress::request_selection(const Endpoint& robot, Clock::time_point) {
                  requester_->wanted().group_select);
   else
     spdlog::warn("could not send the selection request to {}", robot.to_string());
+}
+
+std::optional<FlightRecorder::Dump> Ingress::dump_flight_recorder(std::string_view reason) {
+  if (!recorder_) return std::nullopt;
+  return recorder_->dump(reason);
 }
 
 bool Ingress::link_changed(Clock::time_point now) {
@@ -196,6 +251,12 @@ void Ingress::log_rejections() {
                  last_rejected_sender_.to_string(), to_string(last_rejection_.category()),
                  last_rejection_.message());
   logged_invalid_ = counters_.invalid;
+
+  if (standard_topics_ && standard_topics_->dropped() > logged_standard_dropped_) {
+    spdlog::warn("ROS 2 standard topics: {} snapshots dropped, their publishing thread is behind",
+                 standard_topics_->dropped() - logged_standard_dropped_);
+    logged_standard_dropped_ = standard_topics_->dropped();
+  }
 }
 
 }  // namespace rsg::gateway

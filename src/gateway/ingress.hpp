@@ -9,20 +9,24 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "rsg/frame.hpp"
-#include "rsg/gateway/clock.hpp"
-#include "rsg/gateway/link_monitor.hpp"
-#include "rsg/gateway/selection_requester.hpp"
-#include "rsg/gateway/sequence_tracker.hpp"
-#include "rsg/gateway/source_filter.hpp"
-#include "rsg/gateway/stats.hpp"
-#include "rsg/participant.hpp"
-#include "rsg/robot_state.hpp"
-#include "rsg/udp_socket.hpp"
+#include "clock.hpp"
+#include "decimator.hpp"
+#include "flight_recorder.hpp"
+#include "link_monitor.hpp"
+#include "ros2_standard_topics.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/robot_state.hpp"
+#include "rsg/transport/udp_socket.hpp"
+#include "rsg/wire/frame.hpp"
+#include "selection_requester.hpp"
+#include "sequence_tracker.hpp"
+#include "source_filter.hpp"
+#include "stats.hpp"
 
 namespace rsg::gateway {
 
@@ -33,12 +37,26 @@ class Ingress {
     int receive_buffer = 0;
     SourceFilter sources;
     std::string topic;
+    std::string type_name;  ///< "" : rsg::RobotState; else e.g. rsg::kRos2RobotStateType
     std::vector<std::string> partitions;
     std::string writer_profile;
     Clock::duration nominal_period{};
     std::uint64_t restart_threshold_ms = 0;
     std::optional<Selection> requested_selection;
     std::optional<Endpoint> robot;  ///< where selection requests go; unset: the frames' source
+    std::optional<FlightRecorder::Options> flight_recorder;  ///< keep the last seconds of datagrams
+    /// Downsampled copies: each topic gets the frames that fall due at its period (same type).
+    struct RateTopic {
+      std::string topic;
+      std::chrono::nanoseconds period{};
+    };
+    std::vector<RateTopic> rate_topics;
+    /// sensor_msgs/JointState, TF and the external wrench, each at its own rate, written by a
+    /// thread of their own from snapshots the ingress thread leaves (ros2_standard_topics.hpp).
+    std::optional<Ros2StandardTopics::Options> standard_topics;
+    /// Called on the ingress thread with every valid sample just before it is written, so an
+    /// in-process consumer (rsg::EmbeddedGateway) gets it without a socket or a DDS hop.
+    std::function<void(const RobotState&)> on_sample;
   };
 
   /// Binds the socket and creates the writer. Throws std::runtime_error / std::system_error.
@@ -73,10 +91,27 @@ class Ingress {
 
   Endpoint local_endpoint() const { return socket_.local_endpoint(); }
 
+  /// Writes the flight recorder's datagrams as a pcap file; nothing when it is off. Allocates and
+  /// writes a file: call it on a request or a link change, not per frame. Throws std::runtime_error.
+  std::optional<FlightRecorder::Dump> dump_flight_recorder(std::string_view reason);
+  bool has_flight_recorder() const { return recorder_.has_value(); }
+
+  /// The standard ROS 2 topics, when any is on.
+  const Ros2StandardTopics* standard_topics() const {
+    return standard_topics_ ? &*standard_topics_ : nullptr;
+  }
+
  private:
   void handle(const DatagramBatch::Datagram& datagram, Clock::time_point now);
   void reject(const FrameError& error, const Endpoint& sender);
   void request_selection(const Endpoint& robot, Clock::time_point now);
+  void write_rate_topics(const RobotState& sample, std::chrono::nanoseconds t);
+
+  // A downsampled writer: writes the frames its decimator takes.
+  struct RateWriter {
+    fdds::DataWriter* writer = nullptr;
+    Decimator decimator;
+  };
 
   Options options_;
   UdpSocket socket_;
@@ -84,6 +119,8 @@ class Ingress {
   fdds::Publisher* publisher_ = nullptr;
   fdds::DataWriter* writer_ = nullptr;
   bool writer_loans_ = false;
+  std::vector<RateWriter> rate_writers_;
+  std::optional<Ros2StandardTopics> standard_topics_;  // before publisher_ goes
 
   // One frame per buffer: anything longer arrives marked truncated and is rejected unread.
   DatagramBatch batch_;
@@ -94,6 +131,7 @@ class Ingress {
   SequenceTracker sequence_;
   LinkMonitor link_;
   bool link_came_up_ = false;
+  std::optional<FlightRecorder> recorder_;  // receives into its ring instead of batch_'s storage
   std::optional<SelectionRequester> requester_;
   std::uint8_t request_packet_number_ = 0;
 
@@ -102,6 +140,7 @@ class Ingress {
   Endpoint last_rejected_sender_;
   InvalidCounts logged_invalid_{};
   std::uint64_t logged_rejected_source_ = 0;
+  std::uint64_t logged_standard_dropped_ = 0;
   Endpoint last_foreign_sender_;
 };
 

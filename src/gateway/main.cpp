@@ -13,9 +13,8 @@
 #include <iostream>
 #include <sstream>
 
+#include "config.hpp"
 #include "gateway.hpp"
-#include "rsg/gateway/config.hpp"
-#include "rsg/gateway/realtime.hpp"
 
 namespace {
 
@@ -36,6 +35,10 @@ static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler
 
 void request_stop(int) { stop_requested.store(true); }
 
+// SIGUSR1: write the flight recorder's pcap file (the loop does it; a handler may not).
+std::atomic<bool> dump_requested{false};
+void request_dump(int) { dump_requested.store(true); }
+
 void install_stop_handlers() {
   struct sigaction action {};
   action.sa_handler = request_stop;
@@ -43,6 +46,8 @@ void install_stop_handlers() {
   action.sa_flags = 0;  // no SA_RESTART: a blocking receive returns at once with EINTR
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  action.sa_handler = request_dump;
+  sigaction(SIGUSR1, &action, nullptr);
 }
 
 // Every config key becomes a long flag bound to `config`; CLI11 writes only the flags that are
@@ -54,11 +59,15 @@ void add_config_flags(CLI::App& app, GatewayConfig& config, std::string& config_
     const std::string help(key.help);
     std::visit(
         [&](auto member) {
-          CLI::Option* option = app.add_option(flag, config.*member, help);
-          if constexpr (std::is_same_v<decltype(member), std::vector<std::string> GatewayConfig::*>)
-            option->delimiter(',');
-          else
-            option->capture_default_str();
+          if constexpr (std::is_same_v<decltype(member), bool GatewayConfig::*>) {
+            app.add_flag(flag, config.*member, help);  // --ros2, or --ros2=false over a YAML `true`
+          } else {
+            CLI::Option* option = app.add_option(flag, config.*member, help);
+            if constexpr (std::is_same_v<decltype(member), std::vector<std::string> GatewayConfig::*>)
+              option->delimiter(',');
+            else
+              option->capture_default_str();
+          }
         },
         key.member);
   }
@@ -114,23 +123,6 @@ std::optional<int> parse_command_line(int argc, char** argv, GatewayConfig& conf
   return std::nullopt;
 }
 
-// Called once the Gateway exists: Fast DDS has created its threads by then, and they must not
-// inherit the ingress thread's priority and CPU.
-void enter_realtime_mode(const GatewayConfig& config) {
-  const rsg::gateway::RealtimeRequest request{config.rt_priority, config.cpu};
-  if (!request.any()) return;
-  const rsg::gateway::RealtimeOutcome outcome = rsg::gateway::enter_realtime(request);
-  if (!outcome.problems.empty()) {
-    spdlog::warn("real-time mode degraded, running without what was refused: {}", outcome.problems);
-    return;
-  }
-  std::string done;
-  if (outcome.fifo) done += "SCHED_FIFO priority " + std::to_string(request.priority) + ", memory locked";
-  if (outcome.pinned)
-    done += (done.empty() ? "" : ", ") + std::string("on CPU ") + std::to_string(request.cpu);
-  spdlog::info("real-time mode: ingress thread {}", done);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -151,8 +143,8 @@ int main(int argc, char** argv) {
   install_stop_handlers();
   try {
     rsg::gateway::Gateway gateway(setup);
-    enter_realtime_mode(config);
-    gateway.run(stop_requested);
+    rsg::gateway::enter_realtime_mode(config);
+    gateway.run(stop_requested, &dump_requested);
   } catch (const std::exception& error) {
     spdlog::error("cannot start: {}", error.what());
     return kExitUsage;

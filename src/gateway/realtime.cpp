@@ -1,4 +1,4 @@
-#include "rsg/gateway/realtime.hpp"
+#include "realtime.hpp"
 
 #include <pthread.h>
 #include <sched.h>

@@ -1,6 +1,6 @@
-#include "rsg/gateway/sequence_tracker.hpp"
+#include "sequence_tracker.hpp"
 
-#include "rsg/frame.hpp"
+#include "rsg/wire/frame.hpp"
 
 namespace rsg::gateway {
 namespace {

@@ -1,4 +1,4 @@
-#include "rsg/gateway/source_filter.hpp"
+#include "source_filter.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>

@@ -1,4 +1,4 @@
-#include "rsg/gateway/stats.hpp"
+#include "stats.hpp"
 
 #include <fmt/format.h>
 

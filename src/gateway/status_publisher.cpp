@@ -6,16 +6,19 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <stdexcept>
 
-#include "rsg/gateway/status_sample.hpp"
+#include "status_sample.hpp"
 
 namespace rsg::gateway {
 
 StatusPublisher::StatusPublisher(Participant& participant, const std::string& topic,
-                                 const std::vector<std::string>& partitions, const std::string& profile)
+                                 const std::vector<std::string>& partitions, const std::string& profile,
+                                 const std::string& type_name)
     : participant_(participant) {
   publisher_ = participant_.publisher(partitions);
   // TypeSupport takes ownership of the type object it is given.
-  fdds::Topic* status_topic = participant_.topic(topic, fdds::TypeSupport(new GatewayStatusPubSubType()));
+  fdds::TypeSupport type(new GatewayStatusPubSubType());
+  if (!type_name.empty()) type->setName(type_name.c_str());
+  fdds::Topic* status_topic = participant_.topic(topic, type);
   writer_ = publisher_->create_datawriter_with_profile(status_topic, profile);
   if (!writer_) {
     participant_.get()->delete_publisher(publisher_);

@@ -6,16 +6,18 @@
 #include <string>
 #include <vector>
 
-#include "rsg/gateway/stats.hpp"
-#include "rsg/participant.hpp"
+#include "rsg/dds/participant.hpp"
+#include "stats.hpp"
 
 namespace rsg::gateway {
 
 class StatusPublisher {
  public:
   /// Throws std::runtime_error when the writer cannot be created.
+  /// `type_name` "" keeps the IDL's name (rsg::GatewayStatus), else e.g. rsg::kRos2GatewayStatusType.
   StatusPublisher(Participant& participant, const std::string& topic,
-                  const std::vector<std::string>& partitions, const std::string& profile);
+                  const std::vector<std::string>& partitions, const std::string& profile,
+                  const std::string& type_name = {});
   ~StatusPublisher();
   StatusPublisher(const StatusPublisher&) = delete;
   StatusPublisher& operator=(const StatusPublisher&) = delete;

@@ -1,4 +1,4 @@
-#include "rsg/udp_socket.hpp"
+#include "rsg/transport/udp_socket.hpp"
 
 #include <arpa/inet.h>
 #include <netdb.h>
@@ -75,13 +75,17 @@ DatagramBatch::DatagramBatch(std::size_t capacity, std::size_t buffer_bytes)
   }
 }
 
+void DatagramBatch::receive_into(std::size_t index, std::span<std::uint8_t> buffer) {
+  slots_[index] = {buffer.data(), std::min(buffer.size(), buffer_bytes_)};
+}
+
 DatagramBatch::Datagram DatagramBatch::operator[](std::size_t index) const {
   const mmsghdr& header = headers_[index];
   // With MSG_TRUNC in the receive flags msg_len is the real size; msg_flags says whether it was cut.
   const bool truncated = (header.msg_hdr.msg_flags & MSG_TRUNC) != 0 || header.msg_len > buffer_bytes_;
   const std::size_t kept = std::min<std::size_t>(header.msg_len, buffer_bytes_);
-  return {std::span(storage_).subspan(index * buffer_bytes_, kept), header.msg_len, truncated,
-          senders_[index]};
+  return {std::span(static_cast<const std::uint8_t*>(slots_[index].iov_base), kept), header.msg_len,
+          truncated, senders_[index]};
 }
 
 UdpSocket UdpSocket::bind(const Endpoint& local) {

@@ -1,4 +1,4 @@
-#include "rsg/copy_plan.hpp"
+#include "rsg/wire/copy_plan.hpp"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "rsg/crc32.hpp"
+#include "rsg/wire/crc32.hpp"
 
 #include <isa-l/crc.h>
 

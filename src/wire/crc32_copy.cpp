@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "rsg/crc32.hpp"
+#include "rsg/wire/crc32.hpp"
 
 // The stitched kernel is compiled for AVX-512 and runs only where has_stitched_crc32() says so.
 #define RSG_STITCHED \

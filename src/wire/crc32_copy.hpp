@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <span>
 
-#include "rsg/copy_plan.hpp"
+#include "rsg/wire/copy_plan.hpp"
 
 namespace rsg::detail {
 

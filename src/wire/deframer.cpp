@@ -1,8 +1,8 @@
-#include "rsg/deframer.hpp"
+#include "rsg/wire/deframer.hpp"
 
 #include <cstring>
 
-#include "rsg/crc32.hpp"
+#include "rsg/wire/crc32.hpp"
 
 namespace rsg {
 

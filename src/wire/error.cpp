@@ -1,4 +1,4 @@
-#include "rsg/error.hpp"
+#include "rsg/wire/error.hpp"
 
 #include <cstdarg>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "rsg/frame.hpp"
+#include "rsg/wire/frame.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -6,9 +6,9 @@
 
 #include "crc32_copy.hpp"
 #include "group_bytes.hpp"
-#include "rsg/crc32.hpp"
-#include "rsg/error_flags.hpp"
-#include "rsg/frame_codec.hpp"
+#include "rsg/wire/crc32.hpp"
+#include "rsg/wire/error_flags.hpp"
+#include "rsg/wire/frame_codec.hpp"
 
 namespace rsg {
 

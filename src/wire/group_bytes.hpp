@@ -5,8 +5,8 @@
 #include <array>
 #include <cstdint>
 
-#include "rsg/field_table.hpp"
-#include "rsg/selection.hpp"
+#include "rsg/wire/field_table.hpp"
+#include "rsg/wire/selection.hpp"
 
 namespace rsg::detail {
 

@@ -1,4 +1,4 @@
-#include "rsg/hex.hpp"
+#include "rsg/wire/hex.hpp"
 
 namespace rsg {
 

@@ -1,11 +1,11 @@
-#include "rsg/json.hpp"
+#include "rsg/wire/json.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "rsg/error_flags.hpp"
+#include "rsg/wire/error_flags.hpp"
 
 namespace rsg {
 namespace {
@@ -239,7 +239,7 @@ bool parse_canonical_json(std::string_view text, StateValues& out, std::string& 
   for (const auto& [key, value] : fields.items()) {
     const auto field = find_field(key);
     if (!field) {
-      error = "fields: '" + key + "' is not a field name of PROTOCOL.md";
+      error = "fields: '" + key + "' is not a field name of docs/protocol.md";
       return false;
     }
     if (!values.selection.contains(*field)) {

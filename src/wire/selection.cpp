@@ -1,4 +1,4 @@
-#include "rsg/selection.hpp"
+#include "rsg/wire/selection.hpp"
 
 #include <charconv>
 
@@ -49,7 +49,7 @@ bool parse_field_list(std::string_view list, Selection& out, std::string& error)
   const bool ok = for_each_item(list, error, [&](std::string_view item) {
     const auto field = find_field(item);
     if (!field) {
-      error = "'" + std::string(item) + "' is not a field name of PROTOCOL.md";
+      error = "'" + std::string(item) + "' is not a field name of docs/protocol.md";
       return false;
     }
     selection.add(*field);

@@ -1,8 +1,8 @@
-#include "rsg/state_values.hpp"
+#include "rsg/wire/state_values.hpp"
 
 #include <cassert>
 
-#include "rsg/frame.hpp"
+#include "rsg/wire/frame.hpp"
 
 namespace rsg {
 

@@ -14,12 +14,12 @@
 #include <span>
 #include <vector>
 
-#include "rsg/crc32.hpp"
-#include "rsg/deframer.hpp"
-#include "rsg/error_flags.hpp"
-#include "rsg/frame.hpp"
-#include "rsg/frame_codec.hpp"
-#include "rsg/state_values.hpp"
+#include "rsg/wire/crc32.hpp"
+#include "rsg/wire/deframer.hpp"
+#include "rsg/wire/error_flags.hpp"
+#include "rsg/wire/frame.hpp"
+#include "rsg/wire/frame_codec.hpp"
+#include "rsg/wire/state_values.hpp"
 
 namespace {
 

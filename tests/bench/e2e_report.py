@@ -23,11 +23,20 @@ LATENCY_ROWS = [
     ("baseline_udp_oneway", "UDP loopback one way (2137-byte datagram)"),
     ("baseline_fastdds", "plain Fast DDS writer -> reader, UDP"),
     ("gateway_udp", "**gateway e2e, UDP**"),
+    ("gateway_udp_ros2_standard", "**gateway e2e, UDP, + JointState, TF, wrench at 100 Hz**"),
     ("baseline_fastdds_shm", "plain Fast DDS writer -> reader, SHM"),
     ("gateway_shm", "**gateway e2e, SHM**"),
     ("baseline_fastdds_datasharing", "plain Fast DDS writer -> reader, data-sharing"),
     ("gateway_datasharing", "**gateway e2e, data-sharing**"),
     ("cyclone_ddsperf", "Cyclone DDS ddsperf ping/pong ÷ 2 (UDP)"),
+    # The floor: the leanest relay on each DDS API, and the gateway, each read by both vendors.
+    ("floor_relay_cyclone_to_cyclone", "leanest relay on Cyclone -> Cyclone reader"),
+    ("floor_relay_fastdds_to_cyclone", "leanest relay on Fast DDS -> Cyclone reader"),
+    ("floor_gateway_to_cyclone", "**gateway e2e, UDP -> Cyclone reader**"),
+    ("floor_relay_cyclone_to_fastdds", "leanest relay on Cyclone -> Fast DDS reader"),
+    ("floor_relay_fastdds_to_fastdds", "leanest relay on Fast DDS -> Fast DDS reader"),
+    # gateway_udp above is the gateway read by Fast DDS
+    ("embedded_callback", "**embedded gateway: datagram -> callback in the same process**"),
 ]
 # The percentiles results.json keeps per scenario (besides counts and scenario-specific keys).
 PERCENTILES = ["min_us", "mean_us", "p50_us", "p90_us", "p99_us", "p99.9_us", "max_us"]
@@ -39,6 +48,13 @@ DATASHARING_FRACTION = 0.8
 MIN_ZERO_LOSS_RATE_HZ = 20000
 MAX_CPU_PERCENT = 5.0
 MAX_RSS_GROWTH_KB = 1024
+# Issue 14: the gateway against the leanest relay read by the same reader, the Fast DDS reader
+# against the Cyclone one, and the embedded callback against a raw UDP hop.
+FLOOR_P50_FACTOR = 1.1
+FLOOR_P99_FACTOR = 1.25
+READER_P50_FACTOR = 1.1
+EMBEDDED_P50_FACTOR = 1.5
+EMBEDDED_P99_FACTOR = 3.0
 
 
 def read_json(path):
@@ -101,6 +117,7 @@ def judge(results):
                           limit, shared["p50_us"] <= limit and shared.get("data_sharing_used"),
                           f"ratio {shared['p50_us'] / gateway['p50_us']:.2f}; data-sharing "
                           f"{'used' if shared.get('data_sharing_used') else 'NOT used'}"))
+    goals += judge_floor(results)
     if "max_rate_zero_loss_hz" in results:
         rate = results["max_rate_zero_loss_hz"]
         shared_rate = results.get("max_rate_datasharing_zero_loss_hz")
@@ -117,6 +134,48 @@ def judge(results):
         goals.append(goal("gateway RSS growth over the soak <= 1 MB", growth, MAX_RSS_GROWTH_KB,
                           growth <= MAX_RSS_GROWTH_KB,
                           f"VmRSS after warm-up vs end of a {results['soak']['duration_s']:.0f} s run"))
+    return goals
+
+
+def judge_floor(results):
+    """Issue 14's goals: ratios against the floor of the same run."""
+    goals = []
+    gateways = {"cyclone": results.get("floor_gateway_to_cyclone"), "fastdds": results.get("gateway_udp")}
+    for reader, gateway in gateways.items():
+        relays = [(name, results[f"floor_relay_{name}_to_{reader}"]) for name in ("cyclone", "fastdds")
+                  if f"floor_relay_{name}_to_{reader}" in results]
+        if not gateway or not relays:
+            continue
+        name, leanest = min(relays, key=lambda relay: relay[1]["p50_us"])
+        others = "; ".join(f"vs relay on {n}: p50 {gateway['p50_us'] / r['p50_us']:.2f} x, "
+                           f"p99 {gateway['p99_us'] / r['p99_us']:.2f} x" for n, r in relays)
+        goals.append(goal(f"gateway p50 <= 1.1 x the leanest relay, both read by {reader}", gateway["p50_us"],
+                          FLOOR_P50_FACTOR * leanest["p50_us"],
+                          gateway["p50_us"] <= FLOOR_P50_FACTOR * leanest["p50_us"],
+                          f"leanest: the relay on {name} ({leanest['p50_us']:.1f} us); {others}"))
+        goals.append(goal(f"gateway p99 <= 1.25 x the same relay, both read by {reader}", gateway["p99_us"],
+                          FLOOR_P99_FACTOR * leanest["p99_us"],
+                          gateway["p99_us"] <= FLOOR_P99_FACTOR * leanest["p99_us"],
+                          f"relay on {name}: p99 {leanest['p99_us']:.1f} us"))
+    if gateways["cyclone"] and gateways["fastdds"]:
+        fast, cyclone = gateways["fastdds"]["p50_us"], gateways["cyclone"]["p50_us"]
+        goals.append(goal("gateway read by Fast DDS: p50 <= 1.1 x read by Cyclone", fast, READER_P50_FACTOR * cyclone,
+                          fast <= READER_P50_FACTOR * cyclone, f"ratio {fast / cyclone:.2f}"))
+    udp, shared = results.get("gateway_udp"), results.get("gateway_datasharing")
+    if udp and shared:
+        goals.append(goal("gateway data-sharing p50 not slower than UDP", shared["p50_us"], udp["p50_us"],
+                          shared["p50_us"] <= udp["p50_us"], f"ratio {shared['p50_us'] / udp['p50_us']:.2f}"))
+    embedded, raw = results.get("embedded_callback"), results.get("baseline_udp_oneway")
+    if embedded and raw:
+        goals.append(goal("embedded callback p50 <= 1.5 x UDP one way p50", embedded["p50_us"],
+                          EMBEDDED_P50_FACTOR * raw["p50_us"],
+                          embedded["p50_us"] <= EMBEDDED_P50_FACTOR * raw["p50_us"],
+                          f"ratio {embedded['p50_us'] / raw['p50_us']:.2f}"))
+        goals.append(goal("embedded callback p99 <= 3 x UDP one way p99", embedded["p99_us"],
+                          EMBEDDED_P99_FACTOR * raw["p99_us"],
+                          embedded["p99_us"] <= EMBEDDED_P99_FACTOR * raw["p99_us"],
+                          f"ratio {embedded['p99_us'] / raw['p99_us']:.2f}; its DDS reader at the same time: "
+                          f"p50 {embedded['dds_reader']['p50_us']:.1f}, p99 {embedded['dds_reader']['p99_us']:.1f} us"))
     return goals
 
 
@@ -176,18 +235,24 @@ def markdown(results):
             continue
         frames = run.get("received", run.get("round_trips"))
         load = (run.get("load_average") or {}).get("start", [None])[0]
-        cpu = run.get("gateway", {}).get("cpu_percent", run.get("writer_cpu_percent"))
+        cpu = run.get("gateway", {}).get("cpu_percent", run.get("writer_cpu_percent", run.get("publisher_cpu_percent")))
         lines.append(f"| {title} | {fmt(frames)} | {fmt(run.get('lost'))} | {fmt(run['p50_us'])} | "
                      f"{fmt(run['p90_us'])} | {fmt(run['p99_us'])} | {fmt(run.get('p99.9_us'))} | "
                      f"{fmt(run['max_us'])} | {fmt(cpu) + ' %' if cpu is not None else '–'} | {fmt(load, 2)} |")
     lines += ["", "Publisher CPU: the rsg_gateway process (gateway rows) or the plain writer process (Fast DDS "
-              "rows), all threads, as % of one core over the measured part. ddsperf reports percentiles per "
+              "rows), the relay process (floor rows), all threads, as % of one core over the measured part. The floor relays "
+              "receive a datagram, copy the stamp out at a fixed offset and write it, with no validation, each "
+              "written directly on its DDS API (Cyclone: default writer QoS, reliable keep-last 1; Fast DDS: the "
+              "same, profile `bench_relay_writer`); the Cyclone reader is reliable keep-last 100 with a listener, "
+              "like the bench's Fast DDS reader. The embedded row is the controller's callback in the process "
+              "that also sends (like the UDP row's receiver thread). ddsperf reports percentiles per "
               "second; its row is their round-trip-weighted mean, halved (no p99.9). Its \"lost\" counts ping "
               "timeouts.", "", "## Goals", "",
               "| goal | measured | limit | result | detail |", "|---|---:|---:|:---:|---|"]
     for g in results["goals"]:
         lines.append(f"| {g['goal']} | {fmt(float(g['value']))} | {fmt(float(g['limit']))} | "
                      f"{'pass' if g['pass'] else '**miss**'} | {g['how']} |")
+    lines += ros2_standard_section(results)
     for key, transport in (("max_rate", "UDP"), ("max_rate_datasharing", "data-sharing")):
         if key not in results:
             continue
@@ -223,6 +288,24 @@ def markdown(results):
     return "\n".join(lines)
 
 
+def ros2_standard_section(results):
+    """The standard ROS 2 topics' cost: the same gateway run with them off and on, side by side."""
+    off, on = results.get("gateway_udp"), results.get("gateway_udp_ros2_standard")
+    if not (off and on):
+        return []
+    received = on.get("ros2_standard_received", {})
+    lines = ["", "## Standard ROS 2 topics: cost on the RobotState path", "",
+             f"`--joint-states`, `--tf` and `--external-wrench` at {fmt(on.get('ros2_standard_hz'), 0)} Hz each "
+             "(one reader of each in the bench; messages received: "
+             + ", ".join(f"{name} {fmt(count)}" for name, count in received.items())
+             + "), next to the same run without them.", "",
+             "| standard topics | p50 | p99 | p99.9 | gateway CPU |", "|---|---:|---:|---:|---:|"]
+    for label, run in (("off", off), ("on, 100 Hz each", on)):
+        lines.append(f"| {label} | {fmt(run['p50_us'])} | {fmt(run['p99_us'])} | {fmt(run.get('p99.9_us'))} | "
+                     f"{fmt(run['gateway']['cpu_percent'])} % |")
+    return lines
+
+
 def plot(run_dir, out_dir):
     """latency_cdf.png: CDF (linear fraction) and tail (1 - CDF, log) of every measured latency."""
     if not shutil.which("gnuplot"):
@@ -235,7 +318,8 @@ def plot(run_dir, out_dir):
     # A gateway and its baseline share a colour; the baseline is dashed.
     styles = {"baseline_udp_oneway": "lc 1 dt 3", "baseline_fastdds": "lc 2 dt 2", "gateway_udp": "lc 2 dt 1",
               "baseline_fastdds_shm": "lc 3 dt 2", "gateway_shm": "lc 3 dt 1",
-              "baseline_fastdds_datasharing": "lc 4 dt 2", "gateway_datasharing": "lc 4 dt 1"}
+              "baseline_fastdds_datasharing": "lc 4 dt 2", "gateway_datasharing": "lc 4 dt 1",
+              "embedded_callback": "lc 1 dt 1"}
     cdf = ", ".join(f"'{path}' using 1:2 with lines lw 2 {styles.get(path.stem, '')} title '{title}'"
                     for path, title in curves)
     tail = ", ".join(f"'{path}' using 1:(1-$2) with lines lw 2 {styles.get(path.stem, '')} notitle"

@@ -7,18 +7,27 @@
 #         BENCH_REPETITIONS=5    repetitions per benchmark; the tables show their median
 #   e2e   frames through a running rsg_gateway to a DDS reader, and baselines (rsg_bench_e2e):
 #         bench/results.json, results.md, latency_cdf.png (e2e_report.py), raw runs in bench/e2e/.
-#         About 7 minutes: 30 s per latency run, 10 s per max-rate step (UDP, then data-sharing),
+#         About 11.5 minutes: 30 s per latency run, 10 s per max-rate step (UDP, then data-sharing),
 #         and the 5-minute RSS soak running alongside them.
 #         RSG_BENCH_FULL=1   120 s per latency run, 30 s per max-rate step, the soak on its own
 #                            afterwards (about 25 minutes, quieter numbers)
 #         RSG_BENCH_E2E_SECONDS, RSG_BENCH_E2E_STEP_SECONDS, RSG_BENCH_E2E_SOAK_SECONDS override
 #                            those durations (e.g. a quick try of the suite)
+#   record  rsg_record at 1 kHz full frames for 30 s (bench_record.py): the recorder's CPU, what it
+#         dropped, and the file's compression ratio: bench/record.json.
+#         RSG_BENCH_RECORD_SECONDS overrides the 30 s (600 for the issue's 10-minute run)
+#   scale N robots (robot + gateway each) and M remote readers of one gateway, N, M = 1, 4, 8, 16, in
+#         network namespaces (tests/bench/scale.py; needs root): CPU, RSS, first sample and p50/p99
+#         latency (robot's send to remote reader, rsg_bench_scale_probe) per point: bench/scale/
+#         (scale.json, scale.md, PNG plots), with the Discovery Server. About 3 minutes, plus the
+#         wait for an idle host before each point (up to 2 minutes each).
+#         RSG_BENCH_SCALE_SECONDS   measuring window per point (default 8)
 #
 # A suite is a function run_<suite> that writes its results under $out and a function
 # report_<suite> that prints them, plus its name in SUITES.
 set -euo pipefail
 
-SUITES=(wire e2e)
+SUITES=(wire e2e record scale)
 
 here=$(cd "$(dirname "$0")" && pwd)
 usage() { echo "usage: $0 BUILD_DIR [${SUITES[*]}]" >&2; exit 2; }
@@ -44,7 +53,9 @@ report_wire() { python3 "$here/bench_table.py" "$out/wire.json"; }
 
 # Latency runs in the order the report compares them: baselines next to the gateway they judge.
 e2e_soak_pid=
-E2E_LATENCY_SCENARIOS=(baseline_udp_oneway baseline_fastdds gateway_udp
+E2E_LATENCY_SCENARIOS=(baseline_udp_oneway embedded_callback baseline_fastdds gateway_udp gateway_udp_ros2_standard
+                       floor_relay_fastdds_to_fastdds floor_relay_cyclone_to_fastdds
+                       floor_relay_cyclone_to_cyclone floor_relay_fastdds_to_cyclone floor_gateway_to_cyclone
                        baseline_fastdds_shm gateway_shm
                        baseline_fastdds_datasharing gateway_datasharing
                        cyclone_ddsperf)
@@ -94,6 +105,28 @@ run_e2e() {
   python3 "$here/e2e_report.py" "$runs" "$out" >/dev/null
 }
 report_e2e() { cat "$out/results.md"; }
+
+run_record() {
+  python3 "$here/bench_record.py" "$build" "$out/record.json" --seconds "${RSG_BENCH_RECORD_SECONDS:-30}"
+}
+report_record() {
+  python3 - "$out/record.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+print(f"rsg_record at {r['rate_hz']} Hz, full frames, {r['seconds']:.0f} s ({r['cpu']}, {r['cores']} cores)")
+print()
+print("| recorder CPU | frames sent | states recorded | dropped (gaps / DDS lost) | file | compression ratio |")
+print("|---:|---:|---:|---:|---:|---:|")
+print(f"| {r['recorder_cpu_percent']} % of a core | {r['frames_sent']} | {r['states']} "
+      f"| {r['dropped_sequence_gaps']} / {r['lost_in_dds']} "
+      f"| {r['file_bytes'] / 1e6:.1f} MB | {r['compression_ratio']:.2f} |")
+PY
+}
+run_scale() {
+  python3 "$here/scale.py" --bin "$build/bin" --out "$out/scale" --seconds "${RSG_BENCH_SCALE_SECONDS:-8}" \
+    --discovery-server >/dev/null
+}
+report_scale() { cat "$out/scale/scale.md"; }
 
 for suite in "${selected[@]}"; do
   declare -F "run_$suite" >/dev/null || { echo "$0: unknown suite '$suite'" >&2; usage; }

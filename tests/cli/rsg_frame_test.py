@@ -33,7 +33,7 @@ def run(*args, stdin=b""):
 
 
 def same_value(actual, expected):
-    """JSON equality by value as PROTOCOL.md asks (8.0 == 8), except that -0.0 keeps its sign
+    """JSON equality by value as docs/protocol.md asks (8.0 == 8), except that -0.0 keeps its sign
     and objects must list their keys in the same order (fields in field-index order)."""
     if isinstance(expected, dict):
         return (isinstance(actual, dict) and list(actual) == list(expected)

@@ -7,10 +7,10 @@
 #include <span>
 
 #include "fuzz_check.hpp"
-#include "rsg/deframer.hpp"
-#include "rsg/frame.hpp"
-#include "rsg/frame_codec.hpp"
-#include "rsg/state_values.hpp"
+#include "rsg/wire/deframer.hpp"
+#include "rsg/wire/frame.hpp"
+#include "rsg/wire/frame_codec.hpp"
+#include "rsg/wire/state_values.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::span<const std::uint8_t> bytes(data, size);

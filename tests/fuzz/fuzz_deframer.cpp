@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "fuzz_check.hpp"
-#include "rsg/deframer.hpp"
+#include "rsg/wire/deframer.hpp"
 
 namespace {
 

@@ -6,9 +6,9 @@
 #include <string_view>
 
 #include "fuzz_check.hpp"
-#include "rsg/frame.hpp"
-#include "rsg/json.hpp"
-#include "rsg/state_values.hpp"
+#include "rsg/wire/frame.hpp"
+#include "rsg/wire/json.hpp"
+#include "rsg/wire/state_values.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

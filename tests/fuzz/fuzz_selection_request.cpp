@@ -10,7 +10,7 @@
 #include <span>
 
 #include "fuzz_check.hpp"
-#include "rsg/frame.hpp"
+#include "rsg/wire/frame.hpp"
 
 namespace {
 
@@ -26,7 +26,7 @@ void check_decoding(std::span<const std::uint8_t> bytes) {
   FUZZ_REQUIRE(reencoded && reencoded.size == bytes.size());
   FUZZ_REQUIRE(std::ranges::equal(bytes, encoded));
 
-  // PROTOCOL.md: "a state decoder rejects it (length_mismatch) unless the selection is empty".
+  // docs/protocol.md: a state decoder rejects a request (length_mismatch) unless it selects nothing.
   const rsg::DecodeResult state = rsg::decode(bytes);
   if (request.selection.data_bytes() == 0)
     FUZZ_REQUIRE(state);

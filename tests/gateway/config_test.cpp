@@ -1,4 +1,4 @@
-#include "rsg/gateway/config.hpp"
+#include "config.hpp"
 
 #include <gtest/gtest.h>
 
@@ -53,6 +53,18 @@ request-groups: [2, 5]
   EXPECT_EQ(config.send_to, (std::vector<std::string>{"127.0.0.1:6000", "127.0.0.1:6001"}));
   EXPECT_EQ(config.request_groups, (std::vector<std::string>{"2", "5"}));
   EXPECT_FALSE(check_config(config).has_value()) << *check_config(config);
+}
+
+TEST(GatewayConfig, ReadsDiscoveryServersAndPeers) {
+  const GatewayConfig config = parse_ok(R"(
+discovery-server: [198.18.0.2:11811, "1@gw2.plant:11811"]
+peer: 198.18.0.3,198.18.0.4:7410
+)");
+  EXPECT_EQ(config.discovery_servers, (std::vector<std::string>{"198.18.0.2:11811", "1@gw2.plant:11811"}));
+  EXPECT_EQ(config.peers, (std::vector<std::string>{"198.18.0.3", "198.18.0.4:7410"}));
+  EXPECT_NE(parse_error("discovery-server: 198.18.0.2").message.find("HOST:PORT"), std::string::npos);
+  EXPECT_NE(parse_error("discovery-server: 300@198.18.0.2:11811").message.find("0..255"), std::string::npos);
+  EXPECT_NE(parse_error("peer: 198.18.0.3:0").message.find("port"), std::string::npos);
 }
 
 TEST(GatewayConfig, StartsFromTheGivenDefaults) {
@@ -124,6 +136,70 @@ TEST(GatewayConfig, CombinationsAreChecked) {
   EXPECT_NE(check_config(config)->find("--listen"), std::string::npos);
 }
 
+TEST(GatewayConfig, Ros2ModeAndNamespace) {
+  const GatewayConfig config = parse_ok("listen: 0.0.0.0:5000\nros2: true\nros2-namespace: /robot1\n");
+  EXPECT_TRUE(config.ros2);
+  EXPECT_EQ(config.ros2_namespace, "/robot1");
+  EXPECT_FALSE(check_config(config).has_value());
+
+  EXPECT_EQ(parse_error("ros2: yes\n").message, "ros2: expected true or false");
+  EXPECT_NE(parse_error("ros2: true\nros2-namespace: /robot 1\n").message.find("ros2-namespace"),
+            std::string::npos);
+  EXPECT_NE(parse_error("ros2: true\nros2-namespace: /1robot\n").message.find("digit"), std::string::npos);
+  EXPECT_NE(parse_error("ros2-namespace: /robot1\n").message.find("needs --ros2"), std::string::npos);
+
+  GatewayConfig partitioned = config;
+  partitioned.partition = "p";
+  EXPECT_NE(check_config(partitioned)->find("partitions"), std::string::npos);
+
+  // In ROS 2 mode egress has a default topic (robot_state_cmd): --send-to alone turns it on.
+  GatewayConfig egress = config;
+  egress.send_to = {"127.0.0.1:6000"};
+  EXPECT_TRUE(egress.has_egress());
+  EXPECT_FALSE(check_config(egress).has_value());
+}
+
+TEST(GatewayConfig, RateTopicsAreNameColonHz) {
+  const GatewayConfig config = parse_ok("rate-topic: [slow:50, ui:2.5]\n");
+  ASSERT_EQ(config.rate_topics.size(), 2u);
+  const auto ui = parse_rate_topic(config.rate_topics[1]);
+  ASSERT_TRUE(ui);
+  EXPECT_EQ(ui->name, "ui");
+  EXPECT_EQ(ui->hz, 2.5);
+  for (const char* bad : {"slow", "slow:", ":50", "slow:0", "slow:-1", "slow:50hz", "slow:20000"})
+    EXPECT_FALSE(parse_rate_topic(bad)) << bad;
+  EXPECT_NE(parse_error("rate-topic: slow\n").message.find("NAME:HZ"), std::string::npos);
+}
+
+TEST(GatewayConfig, Ros2StandardTopicsTakeARateNamesAndFrames) {
+  const GatewayConfig config = parse_ok(
+      "listen: 0.0.0.0:5000\njoint-states: 100\ntf: every:10\nexternal-wrench: 2.5\n"
+      "joint-names: [a1, a2, a3, a4, a5, a6, a7]\nbase-frame: world\nee-frame: tool0\nwrench-frame: tool0\n");
+  EXPECT_FALSE(check_config(config).has_value());
+  EXPECT_EQ(config.joint_names.back(), "a7");
+  EXPECT_EQ(config.base_frame, "world");
+  const auto hz = parse_decimation(config.joint_states);
+  ASSERT_TRUE(hz);
+  EXPECT_EQ(hz->every, 0u);
+  EXPECT_EQ(hz->period, std::chrono::milliseconds(10));
+  const auto every = parse_decimation(config.tf);
+  ASSERT_TRUE(every);
+  EXPECT_EQ(every->every, 10u);
+  EXPECT_EQ(GatewayConfig().joint_names.front(), "panda_joint1");
+  EXPECT_EQ(GatewayConfig().wrench_frame, "panda_link0");
+  for (const char* bad :
+       {"0", "-5", "100hz", "20000", "every:", "every:0", "every:x", "every:2000000", "every"})
+    EXPECT_FALSE(parse_decimation(bad)) << bad;
+  EXPECT_NE(parse_error("tf: every:0\n").message.find("every:N"), std::string::npos);
+  EXPECT_NE(parse_error("joint-names: [a, b]\n").message.find("7 names"), std::string::npos);
+  EXPECT_NE(parse_error("base-frame: /world\n").message.find("'/'"), std::string::npos);
+  GatewayConfig egress_only;
+  egress_only.egress_topic = "cmd";
+  egress_only.send_to = {"127.0.0.1:5001"};
+  egress_only.joint_states = "100";
+  EXPECT_NE(check_config(egress_only).value_or("").find("need --listen"), std::string::npos);
+}
+
 TEST(GatewayConfig, ChecksValuesGivenAsFlagsToo) {
   GatewayConfig config;
   config.listen = "0.0.0.0:5000";
@@ -145,6 +221,25 @@ TEST(GatewayConfig, HostileInputIsAnErrorNotACrash) {
   EXPECT_FALSE(parse_gateway_config(std::string(10000, '[')));
   EXPECT_FALSE(parse_gateway_config("&a [*a]"));
   EXPECT_FALSE(parse_gateway_config(std::string_view("listen: \0x", 10)));
+}
+
+TEST(GatewayConfig, FlightRecorderNeedsADirectoryAndAListeningSocket) {
+  const GatewayConfig config = parse_ok("listen: 127.0.0.1:17000\npcap-ring: 2.5\npcap-dir: /tmp\n");
+  EXPECT_EQ(config.pcap_ring, 2.5);
+  EXPECT_EQ(config.pcap_dir, "/tmp");
+  EXPECT_FALSE(check_config(config).has_value());
+
+  GatewayConfig broken = config;
+  broken.pcap_dir.clear();
+  EXPECT_NE(check_config(broken)->find("--pcap-ring needs --pcap-dir"), std::string::npos);
+  broken = config;
+  broken.pcap_ring = -1;
+  EXPECT_NE(check_config(broken)->find("--pcap-ring: must be in 0..600"), std::string::npos);
+  broken = config;
+  broken.listen.clear();
+  broken.egress_topic = "out";
+  broken.send_to = {"127.0.0.1:18000"};
+  EXPECT_NE(check_config(broken)->find("--pcap-ring needs --listen"), std::string::npos);
 }
 
 }  // namespace

@@ -1,9 +1,9 @@
-#include "rsg/gateway/link_monitor.hpp"
+#include "link_monitor.hpp"
 
 #include <gtest/gtest.h>
 
-#include "rsg/gateway/log_throttle.hpp"
-#include "rsg/gateway/selection_requester.hpp"
+#include "log_throttle.hpp"
+#include "selection_requester.hpp"
 
 namespace rsg::gateway {
 namespace {

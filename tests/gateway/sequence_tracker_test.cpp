@@ -1,4 +1,4 @@
-#include "rsg/gateway/sequence_tracker.hpp"
+#include "sequence_tracker.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
-#include "rsg/gateway/source_filter.hpp"
+#include "source_filter.hpp"
 
 #include <gtest/gtest.h>
 
-#include "rsg/udp_socket.hpp"
+#include "rsg/transport/udp_socket.hpp"
 
 namespace rsg::gateway {
 namespace {

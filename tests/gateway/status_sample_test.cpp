@@ -1,4 +1,4 @@
-#include "rsg/gateway/status_sample.hpp"
+#include "status_sample.hpp"
 
 #include <gtest/gtest.h>
 

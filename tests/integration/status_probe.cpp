@@ -9,9 +9,9 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <iostream>
 
-#include "rsg/gateway/status_sample.hpp"
-#include "rsg/participant.hpp"
-#include "rsg/profiles.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "status_sample.hpp"
 
 int main(int argc, char** argv) {
   int domain = 0;

@@ -2,7 +2,7 @@
 
 1. Without --robot the request goes to wherever frames come from: the sim starts with every
    group, honours the request on its sending socket, and every later frame carries group 2 only.
-2. With --robot the request goes out at start-up, byte for byte as PROTOCOL.md defines it.
+2. With --robot the request goes out at start-up, byte for byte as docs/protocol.md defines it.
 """
 
 import socket
@@ -61,7 +61,7 @@ def request_at_start_up(h):
         datagram, sender = robot.recvfrom(65536)
         check(sender[1] == listen_port, f"the request came from port {sender[1]}, not the listening {listen_port}")
         check(datagram == expected_request(0, GROUP_2["group_select"], GROUP_2["data_select"]),
-              f"request bytes {datagram.hex()} differ from PROTOCOL.md's")
+              f"request bytes {datagram.hex()} differ from docs/protocol.md's")
         check(h.stop("gateway_robot", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
 
 

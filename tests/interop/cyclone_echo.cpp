@@ -7,7 +7,7 @@
 #include <string>
 
 #include "cyclone_robot_state.hpp"
-#include "rsg/json.hpp"
+#include "rsg/wire/json.hpp"
 
 int main(int argc, char** argv) {
   if (argc != 6) {
@@ -37,33 +37,13 @@ int main(int argc, char** argv) {
     Entity waitset(dds_create_waitset(participant.get()), "waitset");
     dds_waitset_attach(waitset.get(), reader.get(), 0);
 
-    unsigned long received = 0;
     rsg::StateValues values;
-    std::string line;
-    while (received < count) {
-      if (dds_waitset_wait(waitset.get(), nullptr, 0, timeout) == 0) {
-        std::cerr << "rsg_cyclone_echo: timeout after " << received << " samples\n";
-        return 1;
-      }
-      // Take until the reader is empty: DATA_AVAILABLE is reset by the first take, not re-raised
-      // for what a full buffer left behind.
-      while (received < count) {
-        void* samples[64] = {};  // null: Cyclone loans its own buffers
-        dds_sample_info_t infos[64];
-        const dds_return_t taken = dds_take(reader.get(), samples, infos, 64, 64);
-        if (taken <= 0) break;
-        for (dds_return_t i = 0; i < taken && received < count; ++i) {
-          if (!infos[i].valid_data) continue;
-          rsg::interop::to_values(*static_cast<const rsg_RobotState*>(samples[i]), values);
-          line = rsg::to_canonical_json(values);
-          line += '\n';
-          std::fwrite(line.data(), 1, line.size(), stdout);
-          ++received;
-        }
-        dds_return_loan(reader.get(), samples, taken);
-      }
-      std::fflush(stdout);
-    }
+    const bool complete = rsg::interop::print_samples<rsg_RobotState>(
+        reader.get(), waitset.get(), count, timeout, "rsg_cyclone_echo", [&](const rsg_RobotState& sample) {
+          rsg::interop::to_values(sample, values);
+          return rsg::to_canonical_json(values);
+        });
+    if (!complete) return 1;
     return 0;
   } catch (const std::exception& error) {
     std::cerr << "rsg_cyclone_echo: " << error.what() << '\n';

@@ -8,7 +8,7 @@
 #include <thread>
 
 #include "cyclone_robot_state.hpp"
-#include "rsg/json.hpp"
+#include "rsg/wire/json.hpp"
 
 int main(int argc, char** argv) {
   if (argc != 6) {

@@ -6,13 +6,14 @@
 #include <dds/dds.h>
 
 #include <cstddef>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
 
-#include "rsg/field_layout.hpp"
-#include "rsg/state_values.hpp"
+#include "rsg/wire/field_layout.hpp"
+#include "rsg/wire/state_values.hpp"
 
 namespace rsg::interop {
 
@@ -32,26 +33,72 @@ inline const FieldLayout& cyclone_layout() {
   return layout;
 }
 
-inline void to_values(const rsg_RobotState& sample, StateValues& values) {
+/// Any idlc C struct with RobotState's members (e.g. the ROS 2 type built from rsg_msgs), given
+/// where its fields are.
+template <class Sample>
+void to_values(const Sample& sample, const FieldLayout& layout, StateValues& values) {
   values = StateValues();
   values.packet_number = sample.packet_number;
   values.selection.group_select = sample.group_select;
   std::memcpy(values.selection.data_select.data(), sample.data_select, kGroupCount);
   for (const FieldInfo& field : kFields)
     std::memcpy(StateValues::layout().locate(values.storage(), field.id()),
-                cyclone_layout().locate(&sample, field.id()), field.value_bytes());
+                layout.locate(&sample, field.id()), field.value_bytes());
 }
 
-inline void to_sample(const StateValues& values, rsg_RobotState& sample) {
-  sample = rsg_RobotState{};
+inline void to_values(const rsg_RobotState& sample, StateValues& values) {
+  to_values(sample, cyclone_layout(), values);
+}
+
+/// The other way round, for any such struct.
+template <class Sample>
+void to_sample(const StateValues& values, const FieldLayout& layout, Sample& sample) {
+  sample = Sample{};
   sample.packet_number = values.packet_number;
   sample.group_select = values.selection.group_select;
   std::memcpy(sample.data_select, values.selection.data_select.data(), kGroupCount);
   for (std::size_t group = 0; group < kGroupCount; ++group)
     sample.group_present[group] = values.selection.has_group(group);
   for (const FieldInfo& field : kFields)
-    std::memcpy(cyclone_layout().locate(&sample, field.id()),
+    std::memcpy(layout.locate(&sample, field.id()),
                 StateValues::layout().locate(values.storage(), field.id()), field.value_bytes());
+}
+
+inline void to_sample(const StateValues& values, rsg_RobotState& sample) {
+  to_sample(values, cyclone_layout(), sample);
+}
+
+/// Takes samples from `reader` until `count` valid ones were printed, one line each, as
+/// `to_line(sample)` makes it. False after `timeout` without data (the count so far goes to stderr).
+template <class Sample, class ToLine>
+bool print_samples(dds_entity_t reader, dds_entity_t waitset, unsigned long count, dds_duration_t timeout,
+                   const char* program, ToLine to_line) {
+  unsigned long received = 0;
+  std::string line;
+  while (received < count) {
+    if (dds_waitset_wait(waitset, nullptr, 0, timeout) == 0) {
+      std::fprintf(stderr, "%s: timeout after %lu samples\n", program, received);
+      return false;
+    }
+    // Take until the reader is empty: DATA_AVAILABLE is reset by the first take, not re-raised
+    // for what a full buffer left behind.
+    while (received < count) {
+      void* samples[64] = {};  // null: Cyclone loans its own buffers
+      dds_sample_info_t infos[64];
+      const dds_return_t taken = dds_take(reader, samples, infos, 64, 64);
+      if (taken <= 0) break;
+      for (dds_return_t i = 0; i < taken && received < count; ++i) {
+        if (!infos[i].valid_data) continue;
+        line = to_line(*static_cast<const Sample*>(samples[i]));
+        line += '\n';
+        std::fwrite(line.data(), 1, line.size(), stdout);
+        ++received;
+      }
+      dds_return_loan(reader, samples, taken);
+    }
+    std::fflush(stdout);
+  }
+  return true;
 }
 
 /// A Cyclone entity, deleted (with its children) when this goes out of scope.

@@ -24,10 +24,10 @@
 #include <string>
 #include <vector>
 
-#include "rsg/gateway/status_sample.hpp"
-#include "rsg/participant.hpp"
-#include "rsg/profiles.hpp"
-#include "rsg/views.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "rsg/dds/views.hpp"
+#include "status_sample.hpp"
 
 namespace {
 

@@ -31,7 +31,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr std::size_t kLargestUdpPayload = 65507;
-constexpr std::uint16_t kLargestDataLength = 2123;  // PROTOCOL.md: every field selected
+constexpr std::uint16_t kLargestDataLength = 2123;  // docs/protocol.md: every field selected
 constexpr std::uint8_t kStateRequest = 0x30;        // request type 3, packet number 0
 
 /// An IPv4 UDP socket, closed when it goes out of scope.

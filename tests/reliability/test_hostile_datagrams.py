@@ -1,5 +1,6 @@
 """Hostile datagrams: zero-length and oversized ones (2138 .. 65507 bytes), first paced and then as a
-5-second flood of more than 100,000 datagrams a second from rsg_flood.
+5-second flood from rsg_flood as fast as it can send (over 100,000 a second on an idle 2-core host;
+the rate is logged, not asserted: it measures the host, and the counters below hold at any rate).
 
 Pins that the gateway
   * counts each of them in its spec category (zero-length: truncated; larger than the largest frame
@@ -20,10 +21,10 @@ from reliability import (check, check_delivered_exactly_once, log, main, read_js
 RATE_HZ = 1000
 OVERSIZED = (2138, 9000, 30000, 65507)
 PACED = ["--sizes", ",".join(map(str, (0, *OVERSIZED))), "--count", "2000", "--rate", "2000"]
-# Mostly zero-length (cheap enough for > 100k/s on 2 cores), some oversized, one in 32 the largest.
+# Mostly zero-length (cheap enough for > 100k/s on an idle 2-core host), some oversized, one in 32
+# the largest.
 FLOOD_SIZES = [0] * 24 + [2138] * 4 + [9000, 2138, 30000, 65507]
 FLOOD = ["--sizes", ",".join(map(str, FLOOD_SIZES)), "--duration", "5"]
-MIN_FLOOD_RATE = 100_000
 # The gateway allocates its receive buffer at start-up and nothing per datagram; what may grow is
 # DDS and allocator bookkeeping. 8 MiB is far below what keeping even 1 % of the flood would cost.
 RSS_GROWTH_LIMIT_KIB = 8 * 1024
@@ -38,7 +39,7 @@ def flood(h, port, label, args):
 
 
 def invalid_by_size(by_size):
-    """The counters that datagrams of these sizes must raise, per PROTOCOL.md's validation order."""
+    """The counters that datagrams of these sizes must raise, per docs/protocol.md's validation order."""
     truncated = sum(n for size, n in by_size.items() if int(size) < 14)
     return {"truncated": truncated, "length_mismatch": sum(by_size.values()) - truncated}
 
@@ -76,7 +77,6 @@ def body(h):
     flooded = flood(h, port, "flood", FLOOD)
     rate = flooded["sent"] / flooded["seconds"]
     log(h, f"MEASURED flood: {flooded['sent']} datagrams in {flooded['seconds']:.2f} s = {rate:.0f}/s")
-    check(rate >= MIN_FLOOD_RATE, f"rsg_flood reached only {rate:.0f} datagrams/s, not {MIN_FLOOD_RATE}")
     check(gateway.poll() is None, f"the gateway exited ({gateway.returncode}) during the flood")
     # Every datagram sent either reached the gateway or was dropped by the kernel at the gateway's full
     # socket buffer (nothing is lost elsewhere on loopback); wait until the gateway drained the rest.

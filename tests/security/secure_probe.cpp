@@ -48,11 +48,11 @@
 #include <vector>
 
 #include "random_state.hpp"
-#include "rsg/hex.hpp"
-#include "rsg/json.hpp"
-#include "rsg/participant.hpp"
-#include "rsg/profiles.hpp"
-#include "rsg/robot_state.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "rsg/dds/robot_state.hpp"
+#include "rsg/wire/hex.hpp"
+#include "rsg/wire/json.hpp"
 
 namespace rsg::security_probe {
 namespace {

@@ -1,13 +1,13 @@
 // Every crafted corruption is rejected by the codec's decoder with exactly the category it aims at.
-#include "rsg/sim/fault_injector.hpp"
+#include "fault_injector.hpp"
 
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <string>
 
-#include "rsg/sim/panda_model.hpp"
-#include "rsg/sim/schedule.hpp"
+#include "panda_model.hpp"
+#include "schedule.hpp"
 
 namespace rsg::sim {
 namespace {

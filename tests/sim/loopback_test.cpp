@@ -6,9 +6,9 @@
 #include <sstream>
 #include <thread>
 
-#include "rsg/sim/simulator.hpp"
-#include "rsg/sim/udp_stream.hpp"
-#include "rsg/udp_socket.hpp"
+#include "rsg/transport/udp_socket.hpp"
+#include "simulator.hpp"
+#include "udp_stream.hpp"
 
 namespace rsg::sim {
 namespace {

@@ -1,13 +1,13 @@
 // The robot state the simulator fills: consistent with the motion, the spec and itself.
-#include "rsg/sim/panda_model.hpp"
+#include "panda_model.hpp"
 
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
 
-#include "rsg/frame.hpp"
-#include "rsg/sim/panda.hpp"
+#include "panda.hpp"
+#include "rsg/wire/frame.hpp"
 
 namespace rsg::sim {
 namespace {

@@ -1,9 +1,9 @@
 // Kinematics and trajectory of the simulated Panda against known poses and their own derivatives.
-#include "rsg/sim/panda.hpp"
+#include "panda.hpp"
 
 #include <gtest/gtest.h>
 
-#include "rsg/sim/joint_trajectory.hpp"
+#include "joint_trajectory.hpp"
 
 namespace rsg::sim {
 namespace {

@@ -1,4 +1,4 @@
-#include "rsg/sim/schedule.hpp"
+#include "schedule.hpp"
 
 #include <gtest/gtest.h>
 

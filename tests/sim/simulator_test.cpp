@@ -1,5 +1,5 @@
 // The simulator's stream, checked datagram by datagram against its own report and recording.
-#include "rsg/sim/simulator.hpp"
+#include "simulator.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <sstream>
 #include <vector>
 
-#include "rsg/json.hpp"
+#include "rsg/wire/json.hpp"
 
 namespace rsg::sim {
 namespace {

@@ -1,10 +1,10 @@
 // The stream deframer finds every frame however the stream is chunked and skips garbage.
-#include "rsg/deframer.hpp"
+#include "rsg/wire/deframer.hpp"
 
 #include <gtest/gtest.h>
 
 #include "random_state.hpp"
-#include "rsg/frame.hpp"
+#include "rsg/wire/frame.hpp"
 
 namespace rsg {
 namespace {

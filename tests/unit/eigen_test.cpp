@@ -1,9 +1,9 @@
 // Pins the Eigen conventions: column-major poses, translation at 12..14, no copies.
-#include "rsg/eigen.hpp"
+#include "rsg/dds/eigen.hpp"
 
 #include <gtest/gtest.h>
 
-#include "rsg/robot_state.hpp"
+#include "rsg/dds/robot_state.hpp"
 
 namespace rsg {
 namespace {

@@ -1,5 +1,5 @@
-// The table agrees with PROTOCOL.md's columns that it does not derive itself.
-#include "rsg/field_table.hpp"
+// The table agrees with docs/protocol.md's columns that it does not derive itself.
+#include "rsg/wire/field_table.hpp"
 
 #include <gtest/gtest.h>
 

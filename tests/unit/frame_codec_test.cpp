@@ -3,7 +3,7 @@
 // The kernel is held to the plain path bit for bit over random selections, random struct layouts
 // (fields shuffled, with gaps) and random placements of frame and struct, including placements
 // where its 64-byte accesses straddle a page boundary.
-#include "rsg/frame_codec.hpp"
+#include "rsg/wire/frame_codec.hpp"
 
 #include <gtest/gtest.h>
 
@@ -17,10 +17,10 @@
 
 #include "crc32_copy.hpp"
 #include "random_state.hpp"
-#include "rsg/copy_plan.hpp"
-#include "rsg/crc32.hpp"
-#include "rsg/frame.hpp"
-#include "rsg/state_values.hpp"
+#include "rsg/wire/copy_plan.hpp"
+#include "rsg/wire/crc32.hpp"
+#include "rsg/wire/frame.hpp"
+#include "rsg/wire/state_values.hpp"
 
 namespace rsg {
 namespace {

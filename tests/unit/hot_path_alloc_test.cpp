@@ -17,10 +17,10 @@
 
 #include "allocation_counter.hpp"
 #include "random_state.hpp"
-#include "rsg/frame.hpp"
-#include "rsg/participant.hpp"
-#include "rsg/profiles.hpp"
-#include "rsg/robot_state.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "rsg/dds/robot_state.hpp"
+#include "rsg/wire/frame.hpp"
 
 namespace rsg {
 namespace {

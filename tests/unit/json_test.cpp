@@ -1,5 +1,5 @@
 // Canonical JSON: the spec's example, special values, and clear errors for bad input.
-#include "rsg/json.hpp"
+#include "rsg/wire/json.hpp"
 
 #include <gtest/gtest.h>
 

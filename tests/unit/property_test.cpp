@@ -2,8 +2,8 @@
 #include <gtest/gtest.h>
 
 #include "random_state.hpp"
-#include "rsg/frame.hpp"
-#include "rsg/json.hpp"
+#include "rsg/wire/frame.hpp"
+#include "rsg/wire/json.hpp"
 
 namespace rsg {
 namespace {

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include "rsg/error_flags.hpp"
-#include "rsg/state_values.hpp"
+#include "rsg/wire/error_flags.hpp"
+#include "rsg/wire/state_values.hpp"
 
 namespace rsg::test {
 

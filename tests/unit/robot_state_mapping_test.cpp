@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "rsg/robot_state.hpp"
+#include "rsg/dds/robot_state.hpp"
 #include "vectors.hpp"
 
 namespace rsg {

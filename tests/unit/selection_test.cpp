@@ -1,9 +1,9 @@
 // Selections, field lists and the spec's selection-request frame.
-#include "rsg/selection.hpp"
+#include "rsg/wire/selection.hpp"
 
 #include <gtest/gtest.h>
 
-#include "rsg/frame.hpp"
+#include "rsg/wire/frame.hpp"
 
 namespace rsg {
 namespace {

@@ -1,5 +1,5 @@
 // UdpSocket over loopback: round trip, batch receive, oversize detection, address parsing errors.
-#include "rsg/udp_socket.hpp"
+#include "rsg/transport/udp_socket.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Loads the conformance vectors copied from ../shared/vectors into tests/data/vectors.
+// Loads the conformance vectors kept as delivered in tests/data/vectors.
 #pragma once
 
 #include <fstream>
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "rsg/hex.hpp"
+#include "rsg/wire/hex.hpp"
 
 namespace rsg::test {
 

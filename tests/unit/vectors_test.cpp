@@ -5,11 +5,11 @@
 
 #include <cstring>
 
-#include "rsg/crc32.hpp"
-#include "rsg/frame.hpp"
-#include "rsg/frame_codec.hpp"
-#include "rsg/json.hpp"
-#include "rsg/state_values.hpp"
+#include "rsg/wire/crc32.hpp"
+#include "rsg/wire/frame.hpp"
+#include "rsg/wire/frame_codec.hpp"
+#include "rsg/wire/json.hpp"
+#include "rsg/wire/state_values.hpp"
 
 namespace rsg {
 namespace {

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "random_state.hpp"
-#include "rsg/field_table.hpp"
-#include "rsg/state_values.hpp"
+#include "rsg/wire/field_table.hpp"
+#include "rsg/wire/state_values.hpp"
 
 namespace rsg::test {
 

@@ -13,10 +13,10 @@
 #include <thread>
 
 #include "mixed_stream.hpp"
-#include "rsg/json.hpp"
-#include "rsg/participant.hpp"
-#include "rsg/profiles.hpp"
-#include "rsg/robot_state.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "rsg/dds/robot_state.hpp"
+#include "rsg/wire/json.hpp"
 
 namespace fdds = eprosima::fastdds::dds;
 

@@ -1,7 +1,7 @@
 // Group views in one process: the shipped profiles mean what their names say, broken profiles are
 // refused with a message naming the problem, and a reader on a view of groups S receives exactly
 // the samples whose group_select contains all of S, unchanged.
-#include "rsg/views.hpp"
+#include "rsg/dds/views.hpp"
 
 #include <RobotStatePubSubTypes.h>
 #include <gtest/gtest.h>
@@ -14,9 +14,9 @@
 #include <memory>
 
 #include "mixed_stream.hpp"
-#include "rsg/participant.hpp"
-#include "rsg/profiles.hpp"
-#include "rsg/robot_state.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "rsg/dds/robot_state.hpp"
 
 namespace rsg {
 namespace {
@@ -43,7 +43,7 @@ TEST_F(Views, GroupFilterExpressionIsTheDocumentedDdsSql) {
   EXPECT_EQ(group_view(0b000101).name, "groups_0_2");
 }
 
-// Pins the shipped view names to the groups PROTOCOL.md puts their fields in.
+// Pins the shipped view names to the groups docs/protocol.md puts their fields in.
 TEST_F(Views, ShippedViewsCarryTheGroupsTheirNamesSay) {
   Participant participant(test_domain(), "rsg_participant");
   const fdds::Subscriber& subscriber = *participant.subscriber();

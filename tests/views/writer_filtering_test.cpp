@@ -18,10 +18,10 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
 #include "mixed_stream.hpp"
-#include "rsg/participant.hpp"
-#include "rsg/profiles.hpp"
-#include "rsg/robot_state.hpp"
-#include "rsg/views.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "rsg/dds/robot_state.hpp"
+#include "rsg/dds/views.hpp"
 #include "sent_data_recorder.hpp"
 
 namespace rsg {

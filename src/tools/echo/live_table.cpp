@@ -4,7 +4,7 @@
 #include <cstdarg>
 #include <cstdio>
 
-#include "rsg/error_flags.hpp"
+#include "rsg/wire/error_flags.hpp"
 
 namespace rsg::echo {
 namespace {

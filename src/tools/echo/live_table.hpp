@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "rsg/state_values.hpp"
+#include "rsg/wire/state_values.hpp"
 
 namespace rsg::echo {
 

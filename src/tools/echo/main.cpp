@@ -22,19 +22,23 @@
 #include <thread>
 
 #include "live_table.hpp"
-#include "rsg/json.hpp"
-#include "rsg/participant.hpp"
-#include "rsg/profiles.hpp"
-#include "rsg/robot_state.hpp"
-#include "rsg/selection.hpp"
-#include "rsg/views.hpp"
+#include "rsg/dds/discovery_cli.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "rsg/dds/robot_state.hpp"
+#include "rsg/dds/ros2.hpp"
+#include "rsg/dds/views.hpp"
+#include "rsg/wire/json.hpp"
+#include "rsg/wire/selection.hpp"
+#include "stop_on_signal.hpp"
+#include "tool_main.hpp"
 
 namespace {
 
 namespace fdds = eprosima::fastdds::dds;
 using rsg::echo::Clock;
 
-enum ExitCode : int { kExitOk = 0, kExitFailure = 1, kExitUsage = 2 };
+using namespace rsg::tools;  // exit statuses
 
 // The table is redrawn at most this often, and the timeout checked as often.
 constexpr auto kRefreshPeriod = std::chrono::milliseconds(100);
@@ -42,6 +46,8 @@ constexpr auto kRefreshPeriod = std::chrono::milliseconds(100);
 struct Options {
   int domain = 0;
   std::string topic = "robot_state";
+  bool ros2 = false;  // the ROS 2 DDS names that rsg_gateway --ros2 writes
+  std::string ros2_namespace;
   std::vector<std::string> partitions;
   std::string view_profile;
   std::string groups;
@@ -51,40 +57,10 @@ struct Options {
   double timeout_seconds = 0;
   std::vector<std::string> profiles;  // empty: rsg::default_profiles_dir()
   std::string participant_profile = "rsg_participant";
+  rsg::DiscoveryOptions discovery;
 };
 
-/// Turns SIGINT and SIGTERM into a trigger of `stop`. The signals are blocked in every thread
-/// (block_stop_signals runs before DDS starts its threads) and taken here synchronously, so no
-/// async-signal-unsafe code ever runs in a handler.
-class StopOnSignal {
- public:
-  static void block_stop_signals() {
-    const sigset_t signals = stop_signals();
-    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-  }
-
-  explicit StopOnSignal(fdds::GuardCondition& stop)
-      : thread_([&stop](std::stop_token token) {
-          const sigset_t signals = stop_signals();
-          const timespec poll{0, 100'000'000};  // to notice the stop request
-          while (!token.stop_requested())
-            if (sigtimedwait(&signals, nullptr, &poll) > 0) {
-              stop.set_trigger_value(true);
-              return;
-            }
-        }) {}
-
- private:
-  static sigset_t stop_signals() {
-    sigset_t signals;
-    sigemptyset(&signals);
-    sigaddset(&signals, SIGINT);
-    sigaddset(&signals, SIGTERM);
-    return signals;
-  }
-
-  std::jthread thread_;
-};
+using rsg::tools::StopOnSignal;
 
 const char* policy_name(fdds::QosPolicyId_t id) {
   switch (id) {
@@ -157,6 +133,11 @@ void add_options(CLI::App& app, Options& options) {
       ->capture_default_str();
   app.add_option("--topic", options.topic, "RobotState topic")->capture_default_str();
   app.add_option("--partition", options.partitions, "DDS partition (repeatable; default: none)");
+  app.add_flag(
+      "--ros2", options.ros2,
+      "Read what rsg_gateway --ros2 writes: topic rt/<ns>/<topic>, type rsg_msgs::msg::dds_::RobotState_");
+  app.add_option("--ros2-namespace", options.ros2_namespace, "ROS 2 namespace with --ros2, e.g. /robot1")
+      ->check([](const std::string& ns) { return rsg::check_ros2_namespace(ns); });
   auto* view = app.add_option("--view", options.view_profile,
                               "View profile, e.g. view_joints: only samples carrying its groups");
   auto* groups = app.add_option("--groups", options.groups,
@@ -179,6 +160,7 @@ void add_options(CLI::App& app, Options& options) {
   app.add_option("--participant-profile", options.participant_profile,
                  "XML participant profile, e.g. rsg_secure_reader under DDS Security")
       ->capture_default_str();
+  rsg::add_discovery_options(app, options.discovery);
 }
 
 /// What the reader reads: a view, or the whole topic.
@@ -193,8 +175,11 @@ std::optional<rsg::View> requested_view(const Options& options, const fdds::Subs
 
 int run(const Options& options) {
   StopOnSignal::block_stop_signals();
-  rsg::Participant participant(options.domain, options.participant_profile);
-  fdds::Topic& topic = *participant.robot_state_topic(options.topic);
+  rsg::Participant participant(options.domain, options.participant_profile, options.discovery);
+  const std::string topic_name =
+      options.ros2 ? rsg::ros2_topic_name(options.ros2_namespace, options.topic) : options.topic;
+  fdds::Topic& topic =
+      *participant.robot_state_topic(topic_name, options.ros2 ? std::string(rsg::kRos2RobotStateType) : "");
   fdds::Subscriber& subscriber = *participant.subscriber(options.partitions);
 
   const std::string qos_profile = !options.qos_profile.empty() ? options.qos_profile
@@ -208,9 +193,9 @@ int run(const Options& options) {
     reader = view_reader->get();
   } else {
     reader = subscriber.create_datareader(&topic, qos);
-    if (reader == nullptr) throw std::runtime_error("cannot create a reader on '" + options.topic + "'");
+    if (reader == nullptr) throw std::runtime_error("cannot create a reader on '" + topic_name + "'");
   }
-  const std::string read_topic = view_reader ? view_reader->filtered_topic()->get_name() : options.topic;
+  const std::string read_topic = view_reader ? view_reader->filtered_topic()->get_name() : topic_name;
 
   std::string header = "rsg_echo  " + read_topic + "  domain " + std::to_string(options.domain);
   for (const auto& partition : options.partitions) header += "  partition " + partition;
@@ -218,7 +203,7 @@ int run(const Options& options) {
   SampleSink sink(options.json, header);
 
   fdds::GuardCondition stop;
-  StopOnSignal stop_on_signal(stop);
+  StopOnSignal stop_on_signal([&stop] { stop.set_trigger_value(true); });
   fdds::StatusCondition& reader_condition = reader->get_statuscondition();
   reader_condition.set_enabled_statuses(fdds::StatusMask::data_available()
                                         << fdds::StatusMask::requested_incompatible_qos());
@@ -249,7 +234,7 @@ int run(const Options& options) {
     fdds::RequestedIncompatibleQosStatus incompatible;
     if (reader->get_requested_incompatible_qos_status(incompatible) == ReturnCode_t::RETCODE_OK &&
         incompatible.total_count_change > 0)
-      std::cerr << "rsg_echo: a writer of '" << options.topic << "' does not match reader profile '"
+      std::cerr << "rsg_echo: a writer of '" << topic_name << "' does not match reader profile '"
                 << qos_profile << "': its " << policy_name(incompatible.last_policy_id)
                 << " offer is below this reader's request\n";
 
@@ -289,30 +274,8 @@ int main(int argc, char** argv) {
       "usage error (including an unknown or malformed profile).");
   Options options;
   add_options(app, options);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kExitOk : kExitUsage;
-  }
-
-  try {
-    if (options.profiles.empty()) rsg::load_profiles(rsg::default_profiles_dir());
-    for (const auto& profiles : options.profiles) rsg::load_profiles(profiles);
-    fdds::DomainParticipantQos unused;
-    if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
-            options.participant_profile, unused) != ReturnCode_t::RETCODE_OK)
-      throw std::runtime_error("no participant profile named '" + options.participant_profile + "'");
-  } catch (const std::exception& error) {
-    std::cerr << "rsg_echo: " << error.what() << '\n';
-    return kExitUsage;
-  }
-  try {
-    return run(options);
-  } catch (const rsg::ViewError& error) {
-    std::cerr << "rsg_echo: " << error.what() << '\n';
-    return kExitUsage;
-  } catch (const std::exception& error) {
-    std::cerr << "rsg_echo: " << error.what() << '\n';
-    return kExitFailure;
-  }
+  if (const auto stop = parse_command_line(app, argc, argv)) return *stop;
+  if (const auto stop = load_profiles("rsg_echo", options.profiles, options.participant_profile))
+    return *stop;
+  return run_reporting_errors("rsg_echo", [&] { return run(options); });
 }

@@ -10,10 +10,10 @@
 #include <string_view>
 #include <vector>
 
-#include "rsg/frame.hpp"
-#include "rsg/hex.hpp"
-#include "rsg/json.hpp"
-#include "rsg/state_values.hpp"
+#include "rsg/wire/frame.hpp"
+#include "rsg/wire/hex.hpp"
+#include "rsg/wire/json.hpp"
+#include "rsg/wire/state_values.hpp"
 
 namespace rsg::frame_tool {
 namespace {

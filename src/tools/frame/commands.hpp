@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <iosfwd>
 
-#include "rsg/selection.hpp"
+#include "rsg/wire/selection.hpp"
 
 namespace rsg::frame_tool {
 

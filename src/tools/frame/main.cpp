@@ -56,7 +56,7 @@ void add_selection(CLI::App& command, Options& options) {
   choice->add_option_function<std::string>("--groups", parse_into(rsg::parse_group_list, "--groups"),
                                            "Comma-separated group numbers 0..5, every field of each");
   choice->add_option_function<std::string>("--fields", parse_into(rsg::parse_field_list, "--fields"),
-                                           "Comma-separated field names of PROTOCOL.md, e.g. q,dq,time");
+                                           "Comma-separated field names of docs/protocol.md, e.g. q,dq,time");
   choice->require_option(1);
 }
 
@@ -65,7 +65,8 @@ void add_selection(CLI::App& command, Options& options) {
 int main(int argc, char** argv) {
   std::ios::sync_with_stdio(false);
 
-  CLI::App app{"Converts SEND_BUF frames (PROTOCOL.md) between binary, hex and canonical JSON.", "rsg_frame"};
+  CLI::App app{"Converts SEND_BUF frames (docs/protocol.md) between binary, hex and canonical JSON.",
+               "rsg_frame"};
   app.require_subcommand(1);
   app.footer(
       "Exit status: 0 success (decode --hex-lines: the input was readable), 1 invalid frame, malformed "

@@ -1,9 +1,9 @@
-#include "rsg/sim/fault_injector.hpp"
+#include "fault_injector.hpp"
 
 #include <cassert>
 #include <cstring>
 
-#include "rsg/crc32.hpp"
+#include "rsg/wire/crc32.hpp"
 
 namespace rsg::sim {
 namespace {

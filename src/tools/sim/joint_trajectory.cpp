@@ -1,4 +1,4 @@
-#include "rsg/sim/joint_trajectory.hpp"
+#include "joint_trajectory.hpp"
 
 #include <algorithm>
 #include <cmath>

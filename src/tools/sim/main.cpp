@@ -1,4 +1,4 @@
-// rsg_sim: a simulated Franka Panda streaming SEND_BUF frames (PROTOCOL.md) over UDP, with the
+// rsg_sim: a simulated Franka Panda streaming SEND_BUF frames (docs/protocol.md) over UDP, with the
 // faults a gateway must survive. See `rsg_sim --help`; the logic lives in rsg_sim_core.
 #include <CLI/CLI.hpp>
 #include <atomic>
@@ -9,8 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "rsg/sim/simulator.hpp"
-#include "rsg/sim/udp_stream.hpp"
+#include "pcap_file.hpp"
+#include "replay.hpp"
+#include "simulator.hpp"
+#include "udp_stream.hpp"
 
 namespace {
 
@@ -40,6 +42,9 @@ struct Options {
   unsigned pause_ms = 0;
   std::string report_path;
   std::string record_path;
+  std::string pcap_path;
+  std::string replay_path;
+  rsg::sim::ReplayOptions replay;
 };
 
 constexpr const char* kScheduleHelp = R"(
@@ -47,7 +52,7 @@ Selection and schedule:
   Without --groups, --fields or --every, every frame carries all 44 fields (2137 bytes, IP-fragmented
   above a 1500-byte MTU). --groups and --fields select fields for every frame; --every adds a periodic
   entry. Frame k (counted from 0, dropped frames included) carries the union of --groups, --fields and
-  every --every N:LIST whose N divides k. LIST is comma-separated field names of PROTOCOL.md, group
+  every --every N:LIST whose N divides k. LIST is comma-separated field names of docs/protocol.md, group
   tokens g0..g5 and/or "all". Example:
       --every 1:q,dq,time --every 100:g1      q, dq, time always; group 1 too in frames 0, 100, 200...
   A frame that no entry covers is sent with no field (a valid header-only frame).
@@ -82,7 +87,7 @@ bool parse_categories(const std::string& list, std::vector<rsg::ErrorCategory>& 
     const std::string name = list.substr(begin, comma - begin);
     const auto category = rsg::parse_error_category(name);
     if (!category || *category == rsg::ErrorCategory::kNone) {
-      error = "'" + name + "' is not an error category of PROTOCOL.md";
+      error = "'" + name + "' is not an error category of docs/protocol.md";
       return false;
     }
     out.push_back(*category);
@@ -151,6 +156,36 @@ void add_options(CLI::App& app, Options& options, rsg::sim::SimConfig& config) {
   app.add_option("--report", options.report_path, "Write the JSON report of what was sent to FILE");
   app.add_option("--record", options.record_path,
                  "Write the canonical JSON of every valid datagram sent to FILE, one per line");
+  app.add_option("--pcap", options.pcap_path, "Also write every datagram sent to FILE as a pcap capture");
+
+  auto* replay = app.add_option_group("Replay", "Send a capture's frames instead of simulating");
+  auto* file =
+      replay->add_option("--replay", options.replay_path,
+                         "Replay the SEND_BUF datagrams of this pcap/pcapng file at their original timing");
+  replay->add_option("--speed", options.replay.speed, "Replay this many times faster")
+      ->check(CLI::Range(1e-3, 1e6))
+      ->needs(file)
+      ->capture_default_str();
+  replay->add_flag("--loop", options.replay.loop, "Start the capture over at its end, until stopped")
+      ->needs(file);
+  replay
+      ->add_option("--port", options.replay.port,
+                   "Replay the datagrams sent to this UDP port (default: that of the first valid frame)")
+      ->needs(file);
+  for (const char* simulation_only :
+       {"--count", "--duration", "--every", "--groups", "--fields", "--record", "--report", "--pcap"})
+    file->excludes(app.get_option(simulation_only));
+}
+
+int run_replay(const Options& options) {
+  const rsg::Endpoint peer = rsg::Endpoint::parse(options.to);
+  rsg::UdpSocket socket = rsg::UdpSocket::for_sending_to(peer);
+  install_stop_handlers();
+  const rsg::sim::ReplayReport report =
+      rsg::sim::replay(options.replay_path, socket, peer, options.replay, g_stop, std::cerr);
+  std::cerr << "rsg_sim: replayed " << report.sent << " datagrams to port " << report.port << " ("
+            << report.passes << " complete passes, " << report.send_failures << " send failures)\n";
+  return report.send_failures == 0 ? kExitOk : kExitFailure;
 }
 
 /// Turns the selection options into the schedule; throws CLI::ValidationError.
@@ -174,7 +209,7 @@ void check_probabilities(const rsg::sim::FaultConfig& faults) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Simulated Franka Panda: streams SEND_BUF frames (PROTOCOL.md) over UDP.", "rsg_sim"};
+  CLI::App app{"Simulated Franka Panda: streams SEND_BUF frames (docs/protocol.md) over UDP.", "rsg_sim"};
   app.footer(std::string(kScheduleHelp) +
              "\n\nRuns until --count/--duration or SIGINT/SIGTERM. Exit status: 0 success, 1 runtime "
              "error (socket, file), 2 usage error.");
@@ -191,6 +226,7 @@ int main(int argc, char** argv) {
   config.pause = std::chrono::milliseconds(options.pause_ms);
 
   try {
+    if (!options.replay_path.empty()) return run_replay(options);
     const rsg::Endpoint peer = rsg::Endpoint::parse(options.to);
     rsg::UdpSocket socket = rsg::UdpSocket::for_sending_to(peer);
     rsg::sim::UdpLink link(socket, peer);
@@ -202,6 +238,9 @@ int main(int argc, char** argv) {
       if (!record) throw std::runtime_error("cannot write '" + options.record_path + "'");
       sim.record_to(&record);
     }
+
+    std::optional<rsg::capture::PcapWriter> pcap;
+    if (!options.pcap_path.empty()) link.capture_to(&pcap.emplace(options.pcap_path));
 
     rsg::sim::StreamLimits limits;
     limits.count = options.count;
@@ -219,6 +258,7 @@ int main(int argc, char** argv) {
       report << sim.report().to_json() << "\n";
       if (!report) throw std::runtime_error("cannot write '" + options.report_path + "'");
     }
+    if (pcap) pcap->flush();
     if (record.is_open() && !record.flush())
       throw std::runtime_error("cannot write '" + options.record_path + "'");
   } catch (const std::exception& e) {

@@ -1,4 +1,4 @@
-#include "rsg/sim/panda.hpp"
+#include "panda.hpp"
 
 #include <cmath>
 

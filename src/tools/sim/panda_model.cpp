@@ -1,10 +1,10 @@
-#include "rsg/sim/panda_model.hpp"
+#include "panda_model.hpp"
 
 #include <array>
 #include <cstring>
 #include <initializer_list>
 
-#include "rsg/sim/panda.hpp"
+#include "panda.hpp"
 
 namespace rsg::sim {
 namespace {

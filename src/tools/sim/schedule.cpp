@@ -1,4 +1,4 @@
-#include "rsg/sim/schedule.hpp"
+#include "schedule.hpp"
 
 #include <charconv>
 
@@ -29,7 +29,7 @@ bool parse_item(std::string_view item, Selection& selection, std::string& error)
       return true;
     }
   }
-  error = "'" + std::string(item) + "' is neither a field name of PROTOCOL.md, a group g0..g5, nor all";
+  error = "'" + std::string(item) + "' is neither a field name of docs/protocol.md, a group g0..g5, nor all";
   return false;
 }
 

@@ -1,4 +1,4 @@
-#include "rsg/sim/sim_report.hpp"
+#include "sim_report.hpp"
 
 #include <nlohmann/json.hpp>
 #include <numeric>

@@ -1,9 +1,9 @@
-#include "rsg/sim/simulator.hpp"
+#include "simulator.hpp"
 
 #include <cassert>
 #include <cmath>
 
-#include "rsg/json.hpp"
+#include "rsg/wire/json.hpp"
 
 namespace rsg::sim {
 

@@ -1,4 +1,6 @@
-#include "rsg/sim/udp_stream.hpp"
+#include "udp_stream.hpp"
+
+#include <sys/socket.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +18,17 @@ constexpr nanoseconds kSpinWindow = std::chrono::microseconds(200);
 constexpr nanoseconds kLongestSleep = std::chrono::milliseconds(50);
 constexpr double kRequestPollsPerSecond = 1000;
 
-void wait_until(Clock::time_point deadline, nanoseconds spin_window, const std::atomic<bool>& stop) {
+std::string describe(const Selection& selection) {
+  std::string fields;
+  for (const FieldInfo& field : kFields)
+    if (selection.contains(field.id())) fields += (fields.empty() ? "" : ",") + std::string(field.name);
+  return fields.empty() ? "no field" : fields;
+}
+
+}  // namespace
+
+void wait_until(std::chrono::steady_clock::time_point deadline, nanoseconds spin_window,
+                const std::atomic<bool>& stop) {
   while (!stop.load(std::memory_order_relaxed)) {
     const nanoseconds remaining = deadline - Clock::now();
     if (remaining <= nanoseconds::zero()) return;
@@ -27,14 +39,23 @@ void wait_until(Clock::time_point deadline, nanoseconds spin_window, const std::
   }
 }
 
-std::string describe(const Selection& selection) {
-  std::string fields;
-  for (const FieldInfo& field : kFields)
-    if (selection.contains(field.id())) fields += (fields.empty() ? "" : ",") + std::string(field.name);
-  return fields.empty() ? "no field" : fields;
+bool UdpLink::send(std::span<const std::uint8_t> datagram) {
+  const bool sent = socket_.send_to(datagram, peer_);
+  if (capture_ != nullptr) {
+    if (!capture_from_) {  // the kernel picks the source port at the first send
+      capture_from_ = capture::endpoint_of(socket_.local_endpoint().address());
+      capture_to_ = capture::endpoint_of(peer_.address());
+      // The socket is unbound, so its address reads 0.0.0.0; the address the kernel sends from is
+      // that of a UDP socket connected to the peer (connecting sends nothing).
+      UdpSocket probe = UdpSocket::for_sending_to(peer_);
+      if (::connect(probe.fd(), peer_.address(), peer_.size()) == 0)
+        capture_from_->ip = capture::endpoint_of(probe.local_endpoint().address()).ip;
+    }
+    const auto now = std::chrono::system_clock::now().time_since_epoch();
+    capture_->write({std::chrono::duration_cast<nanoseconds>(now), *capture_from_, *capture_to_, datagram});
+  }
+  return sent;
 }
-
-}  // namespace
 
 void UdpLink::poll_requests(Simulator& sim, std::ostream& log) {
   Endpoint from;

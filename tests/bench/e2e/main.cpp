@@ -8,6 +8,8 @@
 //
 // Every run has its own DDS domain (pid % 200 + 10), ports the kernel picks, and a scratch
 // directory for the children's logs (kept, and named, when the run fails).
+#include <fastrtps/attributes/LibrarySettingsAttributes.h>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <sys/prctl.h>
 #include <unistd.h>
 
@@ -19,7 +21,7 @@
 #include <iostream>
 #include <map>
 
-#include "rsg/profiles.hpp"
+#include "rsg/dds/profiles.hpp"
 #include "scenarios.hpp"
 
 namespace {
@@ -35,10 +37,22 @@ std::map<std::string, Scenario> scenarios(const std::vector<double>& max_rate_st
   using namespace rsg::bench;
   return {
       {"gateway_udp", [](const BenchOptions& o) { return run_gateway(o, transport_named("udp")); }},
+      // gateway_udp with JointState, TF and the wrench at 100 Hz each (and their readers).
+      {"gateway_udp_ros2_standard", [](const BenchOptions& o) { return run_gateway_ros2_standard(o); }},
       {"gateway_shm", [](const BenchOptions& o) { return run_gateway(o, transport_named("shm")); }},
       {"gateway_datasharing",
        [](const BenchOptions& o) { return run_gateway(o, transport_named("datasharing")); }},
       {"baseline_udp_oneway", [](const BenchOptions& o) { return run_udp_oneway(o); }},
+      {"embedded_callback", [](const BenchOptions& o) { return run_embedded(o); }},
+      {"floor_relay_cyclone_to_cyclone",
+       [](const BenchOptions& o) { return run_floor(o, "relay_cyclone", "cyclone"); }},
+      {"floor_relay_cyclone_to_fastdds",
+       [](const BenchOptions& o) { return run_floor(o, "relay_cyclone", "fastdds"); }},
+      {"floor_relay_fastdds_to_cyclone",
+       [](const BenchOptions& o) { return run_floor(o, "relay_fastdds", "cyclone"); }},
+      {"floor_relay_fastdds_to_fastdds",
+       [](const BenchOptions& o) { return run_floor(o, "relay_fastdds", "fastdds"); }},
+      {"floor_gateway_to_cyclone", [](const BenchOptions& o) { return run_floor(o, "gateway", "cyclone"); }},
       {"baseline_fastdds", [](const BenchOptions& o) { return run_fastdds(o, transport_named("udp")); }},
       {"baseline_fastdds_shm", [](const BenchOptions& o) { return run_fastdds(o, transport_named("shm")); }},
       {"baseline_fastdds_datasharing",
@@ -90,8 +104,9 @@ std::filesystem::path link_profiles(const std::filesystem::path& project_profile
   return dir;
 }
 
-// For ctest: frames reach a subscriber through the gateway over UDP and by data-sharing, and
-// data-sharing really is used only when asked for. Nothing about timing is judged.
+// For ctest: frames reach a subscriber through the gateway over UDP and by data-sharing (and
+// data-sharing really is used only when asked for), through each floor relay, and to the embedded
+// gateway's callback. Nothing about timing is judged.
 int run_smoke(BenchOptions options) {
   constexpr double kSmokeRate = 1000;
   constexpr double kSmokeSeconds = 0.3;
@@ -107,6 +122,21 @@ int run_smoke(BenchOptions options) {
               << " frames arrived, data-sharing "
               << (run["data_sharing_used"].get<bool>() ? "used" : "not used") << '\n';
     ok = ok && arrived && data_sharing_as_asked;
+  }
+  // The floor's relays and Cyclone reader, and the embedded gateway's callback and DDS reader.
+  const std::vector<std::pair<std::string, std::function<json()>>> others = {
+      {"relay_cyclone -> fastdds",
+       [&] { return rsg::bench::run_floor(options, "relay_cyclone", "fastdds"); }},
+      {"relay_fastdds -> cyclone",
+       [&] { return rsg::bench::run_floor(options, "relay_fastdds", "cyclone"); }},
+      {"embedded", [&] { return rsg::bench::run_embedded(options); }},
+  };
+  for (const auto& [name, run_one] : others) {
+    const json run = run_one();
+    const bool reader_got_some =
+        !run.contains("dds_reader") || run["dds_reader"]["received"].get<std::uint64_t>() > 0;
+    std::cout << "smoke " << name << ": " << run["received"] << " of " << run["sent"] << " frames arrived\n";
+    ok = ok && run["received"].get<std::uint64_t>() > 0 && reader_got_some;
   }
   return ok ? 0 : 1;
 }
@@ -164,12 +194,17 @@ int main(int argc, char** argv) {
   app.add_option("--reader-profile", options.reader_profile,
                  "Reader QoS instead of the transport's (experiments)");
   app.add_option("--domain", options.domain, "DDS domain")->capture_default_str();
+  app.add_flag("--reader-waitset", options.reader_waitset,
+               "The Fast DDS reader takes samples on a WaitSet thread, not in its listener (experiments)");
+  app.add_option("--gateway-arg", options.gateway_args,
+                 "One more rsg_gateway argument (repeatable; experiments)")
+      ->allow_extra_args(false);
   app.add_option("--profiles", options.profiles_dir, "The project's XML profiles (file or directory)");
   app.add_option("--bench-profiles", bench_profiles, "The bench's transport profiles")->capture_default_str();
   app.add_option("--ddsperf", options.ddsperf, "Cyclone DDS's ddsperf")->capture_default_str();
   app.add_flag("--keep-scratch", keep_scratch, "Keep the children's logs and stats files");
   app.add_option("--role", role, "(internal) run as the baseline's writer process")
-      ->check(CLI::IsMember({"writer"}));
+      ->check(CLI::IsMember({"writer", "relay"}));
   app.add_option("--transport", transport, "max_rate and writer role: udp, shm or datasharing")
       ->capture_default_str();
   app.add_option("--topic", options.topic, "(writer role) topic name");
@@ -178,7 +213,22 @@ int main(int argc, char** argv) {
   // The sender paces with absolute sleeps on this (the main) thread: without the kernel's default
   // 50 us timer slack a 1 kHz frame leaves within a few us of its due time.
   ::prctl(PR_SET_TIMERSLACK, 1UL);
+  // A reader in this process must get its samples over a transport, as one in another process
+  // would (embedded_callback reads the embedded gateway's writer from here).
+  eprosima::fastrtps::LibrarySettingsAttributes library;
+  library.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(library);
 
+  if (role == "relay") {
+    try {
+      rsg::load_profiles(options.profiles_dir);
+      rsg::bench::run_relay_role(options);
+      return 0;
+    } catch (const std::exception& error) {
+      std::cerr << "rsg_bench_e2e relay: " << error.what() << '\n';
+      return 1;
+    }
+  }
   if (role == "writer") {
     try {
       rsg::load_profiles(options.profiles_dir);

@@ -6,19 +6,24 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <regex>
 #include <stdexcept>
 #include <stop_token>
 #include <thread>
 
+#include "../floor/relay_loop.hpp"
 #include "child_process.hpp"
 #include "latency_log.hpp"
 #include "process_usage.hpp"
-#include "rsg/udp_socket.hpp"
+#include "ros2_standard_readers.hpp"
+#include "rsg/gateway/embedded_gateway.hpp"
+#include "rsg/transport/udp_socket.hpp"
 #include "stamped_frames.hpp"
 #include "state_subscriber.hpp"
 
@@ -79,8 +84,8 @@ struct SendReport {
 /// Sends frames [first, first + count) at `rate_hz` with `send(k)` (false: refused), calling
 /// `once_a_second()` between frames about once a second.
 template <typename Send, typename Tick>
-SendReport send_paced(std::uint64_t first, std::uint64_t count, double rate_hz, Send send,
-                      Tick once_a_second) {
+SendReport send_paced(std::uint64_t first, std::uint64_t count, double rate_hz, Send&& send,
+                      Tick&& once_a_second) {
   const auto frames_per_second = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(rate_hz));
   const Pacer pacer(rate_hz);
   const auto start = Clock::now();
@@ -95,9 +100,24 @@ SendReport send_paced(std::uint64_t first, std::uint64_t count, double rate_hz, 
 }
 
 template <typename Send>
-SendReport send_paced(std::uint64_t first, std::uint64_t count, double rate_hz, Send send) {
+SendReport send_paced(std::uint64_t first, std::uint64_t count, double rate_hz, Send&& send) {
   return send_paced(first, count, rate_hz, send, [] {});
 }
+
+/// Sends stamped frames to one UDP destination: `send(k)` stamps frame k now and sends it.
+class FrameSender {
+ public:
+  explicit FrameSender(const Endpoint& to) : to_(to), socket_(UdpSocket::for_sending_to(to)) {}
+  bool operator()(std::uint64_t k) {
+    frames_.stamp_now(k);
+    return socket_.send_to(frames_.encode(), to_);
+  }
+
+ private:
+  Endpoint to_;
+  UdpSocket socket_;
+  StampedFrames frames_;
+};
 
 json to_json(const LatencySummary& summary) {
   return {{"sent", summary.sent},     {"received", summary.received},
@@ -131,19 +151,42 @@ json read_json_file(const std::filesystem::path& file) {
   return in ? json::parse(in, nullptr, /*allow_exceptions=*/false) : json();
 }
 
-/// rsg_gateway as a child process, on a port the kernel picked, logging to the scratch directory.
+/// Waits until `log` has a line containing `marker` and returns what follows the marker on it.
+std::string wait_for_log_line(const std::filesystem::path& log, std::string_view marker,
+                              ChildProcess& process) {
+  const auto deadline = Clock::now() + kStartupTimeout;
+  while (Clock::now() < deadline) {
+    std::ifstream in(log);
+    for (std::string line; std::getline(in, line);)
+      if (const auto at = line.find(marker); at != std::string::npos) return line.substr(at + marker.size());
+    if (!process.running()) throw std::runtime_error("a child exited at start-up; see " + log.string());
+    std::this_thread::sleep_for(milliseconds(20));
+  }
+  throw std::runtime_error("no '" + std::string(marker) + "' in " + log.string());
+}
+
+/// A relay under test as a child process -- rsg_gateway or a floor relay -- on a port the kernel
+/// picked, logging to the scratch directory.
 class GatewayProcess {
  public:
   GatewayProcess(const BenchOptions& options, const Transport& transport, const std::string& topic,
                  const std::string& label)
-      : log_(options.scratch_dir / ("gateway_" + label + ".log")),
-        stats_(options.scratch_dir / ("gateway_" + label + "_stats.json")),
-        process_({(options.bin_dir / "rsg_gateway").string(), "--listen", "127.0.0.1:0", "--domain",
-                  std::to_string(options.domain), "--topic", topic, "--status-topic", topic + "_status",
-                  "--profiles", options.profiles_dir.string(), "--participant-profile",
-                  std::string(transport.participant_profile), "--writer-profile", options.writer_profile,
-                  "--stats-file", stats_.string()},
-                 log_),
+      : GatewayProcess(
+            {(options.bin_dir / "rsg_gateway").string(), "--listen", "127.0.0.1:0", "--domain",
+             std::to_string(options.domain), "--topic", topic, "--status-topic", topic + "_status",
+             "--profiles", options.profiles_dir.string(), "--participant-profile",
+             std::string(transport.participant_profile), "--writer-profile", options.writer_profile,
+             "--stats-file", (options.scratch_dir / ("gateway_" + label + "_stats.json")).string()},
+            options.scratch_dir / ("gateway_" + label + ".log"),
+            options.scratch_dir / ("gateway_" + label + "_stats.json"), options.gateway_args) {}
+
+  /// Any relay that logs "frames on UDP HOST:PORT" once it listens, with `more_args` after
+  /// `argv`; `stats`: its stats file, if any.
+  GatewayProcess(std::vector<std::string> argv, std::filesystem::path log, std::filesystem::path stats,
+                 const std::vector<std::string>& more_args = {})
+      : log_(std::move(log)),
+        stats_(std::move(stats)),
+        process_(concat(std::move(argv), more_args), log_),
         ingress_(wait_for_ingress()) {}
 
   const Endpoint& ingress() const { return ingress_; }
@@ -152,33 +195,52 @@ class GatewayProcess {
   /// Stops it and returns the counters of its final stats file.
   json stop() {
     process_.stop();
-    return read_json_file(stats_);
+    return stats_.empty() ? json() : read_json_file(stats_);
   }
 
  private:
-  // The gateway logs where it listens ("ingress: frames on UDP 127.0.0.1:PORT -> ..."): with port
-  // 0 that is the only race-free way to learn the port.
+  static std::vector<std::string> concat(std::vector<std::string> argv,
+                                         const std::vector<std::string>& more) {
+    argv.insert(argv.end(), more.begin(), more.end());
+    return argv;
+  }
+  // The relay logs where it listens ("... frames on UDP 127.0.0.1:PORT -> ..."): with port 0 that
+  // is the only race-free way to learn the port.
   Endpoint wait_for_ingress() {
-    constexpr std::string_view kMarker = "frames on UDP ";
-    const auto deadline = Clock::now() + kStartupTimeout;
-    while (Clock::now() < deadline) {
-      std::ifstream in(log_);
-      for (std::string line; std::getline(in, line);)
-        if (const auto at = line.find(kMarker); at != std::string::npos) {
-          const auto begin = at + kMarker.size();
-          return Endpoint::parse(std::string_view(line).substr(begin, line.find(' ', begin) - begin));
-        }
-      if (!process_.running())
-        throw std::runtime_error("rsg_gateway exited at start-up; see " + log_.string());
-      std::this_thread::sleep_for(milliseconds(20));
-    }
-    throw std::runtime_error("rsg_gateway did not report its UDP port; see " + log_.string());
+    const std::string rest = wait_for_log_line(log_, "frames on UDP ", process_);
+    return Endpoint::parse(std::string_view(rest).substr(0, rest.find(' ')));
   }
 
   std::filesystem::path log_;
   std::filesystem::path stats_;
   ChildProcess process_;
   Endpoint ingress_;
+};
+
+/// The bench's Cyclone DDS reader (floor/cyclone_reader.cpp) as a child process.
+class CycloneReader {
+ public:
+  CycloneReader(const BenchOptions& options, const std::string& topic, const std::string& label)
+      : log_(options.scratch_dir / ("cyclone_reader_" + label + ".log")),
+        out_(options.scratch_dir / ("cyclone_reader_" + label + ".txt")),
+        process_({(options.bin_dir / "rsg_bench_cyclone_reader").string(), std::to_string(options.domain),
+                  topic, std::to_string(options.warmup_frames() + options.measured_frames()), out_.string()},
+                 log_) {}
+
+  void wait_for_writer() { wait_for_log_line(log_, "matched", process_); }
+
+  /// Lets it finish (or stops it after `timeout`) and records what it received into `log`.
+  void collect(milliseconds timeout, LatencyLog& log) {
+    if (!process_.wait_for(timeout)) process_.stop();
+    std::ifstream in(out_);
+    std::int64_t index = 0, sent = 0, received = 0;
+    while (in >> index >> sent >> received)
+      log.record(Stamp{static_cast<std::uint64_t>(index), sent}, received);
+  }
+
+ private:
+  std::filesystem::path log_, out_;
+  ChildProcess process_;
 };
 
 json usage_json(const ProcessUsage& start, const ProcessUsage& from, const ProcessUsage& to) {
@@ -214,15 +276,12 @@ json run_gateway(const BenchOptions& options, const Transport& transport) {
 
   Participant participant(options.domain, std::string(transport.participant_profile));
   LatencyLog log(options.warmup_frames(), options.measured_frames());
-  StateSubscriber subscriber(participant, topic, options.reader_profile_for(transport), log);
+  LatencyLog notified(options.warmup_frames(), options.measured_frames());
+  StateSubscriber subscriber(participant, topic, options.reader_profile_for(transport), log,
+                             options.reader_waitset, &notified);
   require(subscriber.wait_for_writer(kStartupTimeout), "the gateway's writer never matched");
 
-  UdpSocket socket = UdpSocket::for_sending_to(gateway.ingress());
-  StampedFrames frames;
-  const auto send = [&](std::uint64_t k) {
-    frames.stamp_now(k);
-    return socket.send_to(frames.encode(), gateway.ingress());
-  };
+  FrameSender send(gateway.ingress());
   send_paced(0, options.warmup_frames(), options.rate_hz, send);
 
   // CPU and RSS from the end of warm-up, so start-up and discovery are not counted.
@@ -245,6 +304,7 @@ json run_gateway(const BenchOptions& options, const Transport& transport) {
   json result = latency_result(options, log, sending);
   result["transport"] = transport.name;
   result["data_sharing_used"] = maps_data_sharing_segment();
+  result["reader_notified"] = to_json(notified.summarize());
   result["host_udp_receive_buffer_drops"] = udp_receive_buffer_drops() - drops_before;
   result["gateway"] = {{"cpu_percent", cpu_percent(after_warmup, at_end)},
                        {"rss_kb_after_warmup", after_warmup.rss_kb},
@@ -253,6 +313,149 @@ json run_gateway(const BenchOptions& options, const Transport& transport) {
                        {"timeline", std::move(timeline)},
                        {"stats", gateway.stop()}};
   return result;
+}
+
+json run_gateway_ros2_standard(const BenchOptions& options, double ros2_standard_hz) {
+  BenchOptions with_topics = options;
+  with_topics.topic += "_ros2_standard";
+  const std::string hz = std::to_string(ros2_standard_hz);
+  for (const char* flag : {"--joint-states", "--tf", "--external-wrench"})
+    with_topics.gateway_args.insert(with_topics.gateway_args.end(), {flag, hz});
+  const Transport& udp = transport_named("udp");
+  Participant participant(options.domain, std::string(udp.participant_profile));
+  const Ros2StandardReaders readers(participant);
+  json result = run_gateway(with_topics, udp);
+  result["ros2_standard_hz"] = ros2_standard_hz;
+  result["ros2_standard_received"] = readers.counts();
+  return result;
+}
+
+json run_embedded(const BenchOptions& options) {
+  const std::string topic =
+      options.topic + "_embedded_" + std::to_string(std::llround(options.rate_hz)) + "hz";
+  LatencyLog callback_log(options.warmup_frames(), options.measured_frames());
+  LatencyLog reader_log(options.warmup_frames(), options.measured_frames());
+  // The clock is read first, as the UDP baseline's receiver and the DDS readers do.
+  // --gateway-arg=--KEY=VALUE becomes "KEY: VALUE" of the configuration (e.g. rt-priority).
+  std::string more;
+  for (const std::string& arg : options.gateway_args)
+    if (const auto equals = arg.find('='); arg.starts_with("--") && equals != std::string::npos)
+      more += arg.substr(2, equals - 2) + ": " + arg.substr(equals + 1) + "\n";
+  EmbeddedGateway gateway(more + "listen: 127.0.0.1:0\ndomain: " + std::to_string(options.domain) +
+                              "\ntopic: " + topic + "\nstatus-topic: " + topic +
+                              "_status\nprofiles: " + options.profiles_dir.string() +
+                              "\nwriter-profile: " + options.writer_profile + "\n",
+                          [&](const RobotState& sample) {
+                            const std::int64_t received_ns = monotonic_ns();
+                            callback_log.record(read_stamp(sample), received_ns);
+                          });
+  // Another participant (intra-process delivery is off in this binary): a remote reader's view.
+  const Transport& udp = transport_named("udp");
+  Participant participant(options.domain, std::string(udp.participant_profile));
+  StateSubscriber subscriber(participant, topic, options.reader_profile_for(udp), reader_log);
+  require(subscriber.wait_for_writer(kStartupTimeout), "the embedded gateway's writer never matched");
+
+  const Endpoint to = gateway.local_endpoint();
+  FrameSender send(to);
+  send_paced(0, options.warmup_frames(), options.rate_hz, send);
+  const ProcessUsage before = read_usage(::getpid());
+  const SendReport sending =
+      send_paced(options.warmup_frames(), options.measured_frames(), options.rate_hz, send);
+  const ProcessUsage after = read_usage(::getpid());
+  subscriber.wait_for_all(kDrainTimeout);
+  gateway.stop();
+  json result = latency_result(options, callback_log, sending);
+  result["dds_reader"] = to_json(reader_log.summarize());
+  result["process_cpu_percent"] = cpu_percent(before, after);  // sender, gateway and reader together
+  return result;
+}
+
+json run_floor(const BenchOptions& options, std::string_view publisher, std::string_view reader) {
+  const std::string label = std::string(publisher) + "_to_" + std::string(reader);
+  const std::string topic = options.topic + "_" + label;
+  const Transport& udp = transport_named("udp");
+  std::vector<std::string> argv;
+  std::filesystem::path stats;
+  if (publisher == "relay_cyclone") {
+    argv = {(options.bin_dir / "rsg_bench_relay_cyclone").string(), std::to_string(options.domain), topic};
+  } else if (publisher == "relay_fastdds") {
+    argv = {(options.bin_dir / "rsg_bench_e2e").string(),
+            "--role",
+            "relay",
+            "--domain",
+            std::to_string(options.domain),
+            "--topic",
+            topic,
+            "--profiles",
+            options.profiles_dir.string(),
+            "--writer-profile",
+            "bench_relay_writer"};
+  } else {
+    stats = options.scratch_dir / ("gateway_" + label + "_stats.json");
+    argv = {(options.bin_dir / "rsg_gateway").string(),
+            "--listen",
+            "127.0.0.1:0",
+            "--domain",
+            std::to_string(options.domain),
+            "--topic",
+            topic,
+            "--status-topic",
+            topic + "_status",
+            "--profiles",
+            options.profiles_dir.string(),
+            "--participant-profile",
+            std::string(udp.participant_profile),
+            "--writer-profile",
+            options.writer_profile,
+            "--stats-file",
+            stats.string()};
+  }
+  GatewayProcess relay(argv, options.scratch_dir / (label + ".log"), stats,
+                       publisher == "gateway" ? options.gateway_args : std::vector<std::string>{});
+
+  LatencyLog log(options.warmup_frames(), options.measured_frames());
+  std::optional<Participant> participant;
+  std::optional<StateSubscriber> fastdds_reader;
+  std::optional<CycloneReader> cyclone_reader;
+  if (reader == "fastdds") {
+    participant.emplace(options.domain, std::string(udp.participant_profile));
+    fastdds_reader.emplace(*participant, topic, options.reader_profile_for(udp), log, options.reader_waitset);
+    require(fastdds_reader->wait_for_writer(kStartupTimeout), "the relay's writer never matched");
+  } else {
+    cyclone_reader.emplace(options, topic, label);
+    cyclone_reader->wait_for_writer();
+  }
+
+  FrameSender send(relay.ingress());
+  send_paced(0, options.warmup_frames(), options.rate_hz, send);
+  const ProcessUsage before = read_usage(relay.pid());
+  const SendReport sending =
+      send_paced(options.warmup_frames(), options.measured_frames(), options.rate_hz, send);
+  const ProcessUsage after = read_usage(relay.pid());
+  if (fastdds_reader)
+    fastdds_reader->wait_for_all(kDrainTimeout);
+  else
+    cyclone_reader->collect(kDrainTimeout, log);
+  json result = latency_result(options, log, sending);
+  result["publisher"] = publisher;
+  result["reader"] = reader;
+  result["publisher_cpu_percent"] = cpu_percent(before, after);
+  result["publisher_stats"] = relay.stop();
+  return result;
+}
+
+json run_relay_role(const BenchOptions& options) {
+  Participant participant(options.domain, std::string(transport_named("udp").participant_profile));
+  fdds::DataWriter* writer = participant.publisher()->create_datawriter_with_profile(
+      participant.robot_state_topic(options.topic), options.writer_profile);
+  require(writer != nullptr, "cannot create a writer with profile '" + options.writer_profile + "'");
+  RobotState sample;
+  relay_frames([&](const StampBytes& stamp) {
+    std::memcpy(sample.elbow_d().data(), stamp.elbow_d, sizeof(double) * 2);
+    std::memcpy(&sample.time(), stamp.time, sizeof sample.time());
+    writer->write(&sample);
+  });
+  return {};
 }
 
 json run_max_rate(const BenchOptions& options, const Transport& transport, const std::vector<double>& rates) {
@@ -309,12 +512,7 @@ json run_udp_oneway(const BenchOptions& options) {
     }
   });
 
-  UdpSocket socket = UdpSocket::for_sending_to(destination);
-  StampedFrames frames;
-  const auto send = [&](std::uint64_t k) {
-    frames.stamp_now(k);
-    return socket.send_to(frames.encode(), destination);
-  };
+  FrameSender send(destination);
   send_paced(0, options.warmup_frames(), options.rate_hz, send);
   const SendReport sending =
       send_paced(options.warmup_frames(), options.measured_frames(), options.rate_hz, send);
@@ -331,7 +529,9 @@ json run_fastdds(const BenchOptions& options, const Transport& transport) {
   const std::string topic = options.topic + "_plain_" + label;
   Participant participant(options.domain, std::string(transport.participant_profile));
   LatencyLog log(options.warmup_frames(), options.measured_frames());
-  StateSubscriber subscriber(participant, topic, options.reader_profile_for(transport), log);
+  LatencyLog notified(options.warmup_frames(), options.measured_frames());
+  StateSubscriber subscriber(participant, topic, options.reader_profile_for(transport), log,
+                             options.reader_waitset, &notified);
 
   const std::filesystem::path writer_log = options.scratch_dir / ("writer_" + label + ".log");
   const std::filesystem::path writer_result = options.scratch_dir / ("writer_" + label + ".json");
@@ -368,6 +568,7 @@ json run_fastdds(const BenchOptions& options, const Transport& transport) {
   json result = latency_result(options, log, sending);
   result["transport"] = transport.name;
   result["data_sharing_used"] = maps_data_sharing_segment();
+  result["reader_notified"] = to_json(notified.summarize());
   result["writer_cpu_percent"] = written["cpu_percent"];
   return result;
 }

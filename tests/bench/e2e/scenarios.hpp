@@ -31,6 +31,10 @@ struct BenchOptions {
   std::string writer_profile = "rsg_state_writer";
   /// Replaces the transport's reader profile (experiments); empty: the transport's.
   std::string reader_profile;
+  /// The bench's Fast DDS reader takes samples on a WaitSet thread instead of in its listener.
+  bool reader_waitset = false;
+  /// More arguments for rsg_gateway (experiments: --rt-priority 50, --cpu 1).
+  std::vector<std::string> gateway_args;
 
   std::string reader_profile_for(const Transport& transport) const {
     return reader_profile.empty() ? std::string(transport.reader_profile) : reader_profile;
@@ -50,10 +54,26 @@ struct BenchOptions {
 /// CPU and RSS, after warm-up, at the end and every `usage_period_s` (a long run is the soak test).
 nlohmann::json run_gateway(const BenchOptions& options, const Transport& transport);
 
+/// `run_gateway` over UDP with the standard ROS 2 topics on (JointState, TF and the wrench, each at
+/// `ros2_standard_hz`) and a reader of each in this process: their cost next to `run_gateway`'s.
+nlohmann::json run_gateway_ros2_standard(const BenchOptions& options, double ros2_standard_hz = 100);
+
 /// Gateway runs of `duration_s` each at rising rates until one loses a frame or the sender
 /// cannot keep the rate; the highest rate without loss.
 nlohmann::json run_max_rate(const BenchOptions& options, const Transport& transport,
                             const std::vector<double>& rates);
+
+/// rsg::EmbeddedGateway in this process: frames over UDP to it, latency at its callback (the
+/// controller's view), and at the same time at a DDS reader of another participant over UDP.
+nlohmann::json run_embedded(const BenchOptions& options);
+
+/// The floor: `publisher` (relay_cyclone, relay_fastdds: the leanest relay on each API; gateway:
+/// rsg_gateway) as a child process, frames to it over UDP, read here by `reader` (fastdds: the
+/// bench's Fast DDS reader; cyclone: rsg_bench_cyclone_reader, a child process).
+nlohmann::json run_floor(const BenchOptions& options, std::string_view publisher, std::string_view reader);
+
+/// The relay role of `run_floor` (relay_fastdds): until SIGTERM.
+nlohmann::json run_relay_role(const BenchOptions& options);
 
 /// Baseline: the same datagram over UDP loopback, one way.
 nlohmann::json run_udp_oneway(const BenchOptions& options);

@@ -4,7 +4,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "rsg/robot_state.hpp"
+#include "rsg/dds/robot_state.hpp"
 
 namespace rsg::bench {
 namespace {

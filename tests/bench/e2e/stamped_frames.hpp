@@ -18,8 +18,8 @@
 #include <optional>
 #include <span>
 
-#include "rsg/frame.hpp"
-#include "rsg/state_values.hpp"
+#include "rsg/wire/frame.hpp"
+#include "rsg/wire/state_values.hpp"
 
 namespace rsg::bench {
 

@@ -1,6 +1,7 @@
 #include "state_subscriber.hpp"
 
 #include <fastdds/dds/core/LoanableSequence.hpp>
+#include <fastdds/dds/core/condition/WaitSet.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fstream>
@@ -25,17 +26,36 @@ bool poll_until(std::chrono::milliseconds timeout, Predicate done) {
 }  // namespace
 
 StateSubscriber::StateSubscriber(Participant& participant, const std::string& topic,
-                                 const std::string& reader_profile, LatencyLog& log)
-    : participant_(participant), log_(log), subscriber_(participant.subscriber()) {
-  reader_ = subscriber_->create_datareader_with_profile(participant.robot_state_topic(topic), reader_profile,
-                                                        this, fdds::StatusMask::data_available());
+                                 const std::string& reader_profile, LatencyLog& log, bool waitset,
+                                 LatencyLog* notified)
+    : participant_(participant), log_(log), notified_(notified), subscriber_(participant.subscriber()) {
+  reader_ = subscriber_->create_datareader_with_profile(
+      participant.robot_state_topic(topic), reader_profile, waitset ? nullptr : this,
+      waitset ? fdds::StatusMask::none() : fdds::StatusMask::data_available());
   if (!reader_) {
     participant_.get()->delete_subscriber(subscriber_);
     throw std::runtime_error("cannot create a RobotState reader with profile '" + reader_profile + "'");
   }
+  if (waitset)
+    waiting_ = std::thread([this] {
+      fdds::StatusCondition& data = reader_->get_statuscondition();
+      data.set_enabled_statuses(fdds::StatusMask::data_available());
+      fdds::WaitSet waitset;
+      waitset.attach_condition(data);
+      waitset.attach_condition(stop_);
+      fdds::ConditionSeq triggered;
+      while (!stop_.get_trigger_value()) {
+        waitset.wait(triggered, eprosima::fastrtps::c_TimeInfinite);
+        take_all(reader_, monotonic_ns());
+      }
+    });
 }
 
 StateSubscriber::~StateSubscriber() {
+  if (waiting_.joinable()) {
+    stop_.set_trigger_value(true);
+    waiting_.join();
+  }
   // Deleting the reader first guarantees no callback runs once the members are gone.
   subscriber_->delete_datareader(reader_);
   participant_.get()->delete_subscriber(subscriber_);
@@ -53,14 +73,21 @@ bool StateSubscriber::wait_for_all(std::chrono::milliseconds timeout) const {
   return poll_until(timeout, [&] { return log_.arrived() == log_.expected(); });
 }
 
-void StateSubscriber::on_data_available(fdds::DataReader* reader) {
+void StateSubscriber::on_data_available(fdds::DataReader* reader) { take_all(reader, monotonic_ns()); }
+
+void StateSubscriber::take_all(fdds::DataReader* reader, std::int64_t notified_ns) {
   fdds::LoanableSequence<RobotState> samples;
   fdds::SampleInfoSeq infos;
   while (reader->take(samples, infos) == ReturnCode_t::RETCODE_OK) {
     const std::int64_t received_ns = monotonic_ns();
     for (fdds::LoanableCollection::size_type i = 0; i < samples.length(); ++i)
-      if (infos[i].valid_data) log_.record(read_stamp(samples[i]), received_ns);
+      if (infos[i].valid_data) {
+        const Stamp stamp = read_stamp(samples[i]);
+        log_.record(stamp, received_ns);
+        if (notified_ != nullptr) notified_->record(stamp, notified_ns);
+      }
     reader->return_loan(samples, infos);
+    notified_ns = monotonic_ns();  // the next take() can only find samples that are there by now
   }
 }
 

@@ -2,25 +2,32 @@
 //
 // Samples are taken in on_data_available, on the Fast DDS thread that delivered them (the
 // transport's receive thread, or data-sharing's listener), with loans: the receive time is read
-// before anything else, and a data-sharing reader reads the stamp in the writer's shared memory
-// without copying the sample.
+// as soon as take() returns, and a data-sharing reader reads the stamp in the writer's shared
+// memory without copying the sample. take() itself is part of what a reader pays (a RELIABLE
+// data-sharing reader of Fast DDS 2.9 sends an ACKNACK inside it), so an optional second log
+// records, for the same samples, the time the listener was entered (before take).
 #pragma once
 
 #include <chrono>
+#include <fastdds/dds/core/condition/GuardCondition.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <string>
+#include <thread>
 
 #include "latency_log.hpp"
-#include "rsg/participant.hpp"
+#include "rsg/dds/participant.hpp"
 
 namespace rsg::bench {
 
 class StateSubscriber : private fdds::DataReaderListener {
  public:
-  /// Creates the reader; `log` must outlive it. Throws std::runtime_error.
+  /// Creates the reader; `log` must outlive it. Samples are taken in the listener, or with
+  /// `waitset` on a thread of this object's own that waits on a WaitSet (as rsg_echo does).
+  /// `notified`, if given, gets each sample's time of entry into the listener (or of the
+  /// WaitSet's wake-up), before take(). Throws std::runtime_error.
   StateSubscriber(Participant& participant, const std::string& topic, const std::string& reader_profile,
-                  LatencyLog& log);
+                  LatencyLog& log, bool waitset = false, LatencyLog* notified = nullptr);
   ~StateSubscriber() override;
   StateSubscriber(const StateSubscriber&) = delete;
   StateSubscriber& operator=(const StateSubscriber&) = delete;
@@ -32,11 +39,15 @@ class StateSubscriber : private fdds::DataReaderListener {
 
  private:
   void on_data_available(fdds::DataReader* reader) override;
+  void take_all(fdds::DataReader* reader, std::int64_t notified_ns);
 
   Participant& participant_;
   LatencyLog& log_;
+  LatencyLog* notified_;
   fdds::Subscriber* subscriber_ = nullptr;
   fdds::DataReader* reader_ = nullptr;
+  fdds::GuardCondition stop_;
+  std::thread waiting_;  // WaitSet mode only
 };
 
 /// True when this process has a Fast DDS data-sharing segment mapped: a data-sharing reader maps

@@ -1,0 +1,47 @@
+// How a participant finds the others when multicast is not there: a Fast DDS Discovery Server,
+// or a fixed list of unicast peers. Every rsg program takes both as options
+// (`--discovery-server`, `--peer`; rsg/dds/discovery_cli.hpp) and applies them to the QoS of
+// its participant profile:
+//
+//   rsg::DiscoveryOptions discovery;
+//   discovery.servers = {"198.18.0.2:11811"};
+//   rsg::Participant participant(domain, "rsg_participant", discovery);
+//
+// A server given as HOST:PORT is the one `fastdds discovery -i N -l HOST -p PORT` runs, where N
+// is its position in the list (0 for the first), as with ROS_DISCOVERY_SERVER; `N@HOST:PORT`
+// names the id explicitly. The server's GUID prefix follows from N (Fast DDS's
+// get_server_client_default_guidPrefix), so nothing else has to be copied between machines.
+#pragma once
+
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <string>
+#include <vector>
+
+namespace rsg {
+
+struct DiscoveryOptions {
+  /// Discovery Servers, "[ID@]HOST:PORT": the participant becomes their CLIENT and sends no
+  /// multicast. Several servers are redundant: each one knows every client of any of them.
+  std::vector<std::string> servers;
+  /// Unicast initial peers, "HOST" or "HOST:PORT", for SIMPLE discovery without multicast:
+  /// participant announcements go to these locators instead of the multicast group. A HOST alone
+  /// stands for the metatraffic ports of participant ids 0..59 on the domain (the gateway takes
+  /// its id from its pid, modulo 60); only one side of a pair has to list the other.
+  std::vector<std::string> peers;
+
+  bool empty() const { return servers.empty() && peers.empty(); }
+};
+
+/// What is wrong with one `--discovery-server` value ("" when it is well-formed). Syntax only:
+/// names are resolved by apply_discovery, so checking a configuration touches no network.
+std::string check_discovery_server(const std::string& value);
+/// Same for one `--peer` value.
+std::string check_peer(const std::string& value);
+
+/// Makes `qos` use the given servers or peers on `domain` (nothing changes when `options` is
+/// empty). Resolves host names (IPv4: rsg's participants use the UDPv4 transport). Throws
+/// std::invalid_argument naming the bad value.
+void apply_discovery(const DiscoveryOptions& options, int domain,
+                     eprosima::fastdds::dds::DomainParticipantQos& qos);
+
+}  // namespace rsg

@@ -1,0 +1,30 @@
+// The command-line options of rsg/dds/discovery.hpp, the same on every rsg program (needs CLI11,
+// header-only):
+//
+//   rsg::DiscoveryOptions discovery;
+//   rsg::add_discovery_options(app, discovery);
+//   ...
+//   rsg::Participant participant(domain, profile, discovery);
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "rsg/dds/discovery.hpp"
+
+namespace rsg {
+
+inline void add_discovery_options(CLI::App& app, DiscoveryOptions& options) {
+  const auto each = [](std::string (*check)(const std::string&)) {
+    return CLI::Validator([check](std::string& value) { return check(value); }, "", "");
+  };
+  app.add_option("--discovery-server", options.servers,
+                 "Find the other participants through this Fast DDS Discovery Server, [ID@]HOST:PORT "
+                 "(repeatable; ID defaults to the position in the list, as `fastdds discovery -i ID`)")
+      ->check(each(check_discovery_server));
+  app.add_option("--peer", options.peers,
+                 "Send discovery announcements to this unicast peer instead of multicast, HOST[:PORT] "
+                 "(repeatable; HOST alone covers participant ids 0..59)")
+      ->check(each(check_peer));
+}
+
+}  // namespace rsg

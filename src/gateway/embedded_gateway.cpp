@@ -1,0 +1,82 @@
+#include "rsg/gateway/embedded_gateway.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <stdexcept>
+#include <thread>
+
+#include "config.hpp"
+#include "gateway.hpp"
+
+namespace rsg {
+namespace {
+
+// Everything rsg_gateway checks before it creates anything, plus the one thing embedding needs.
+gateway::GatewaySetup prepare_embedded(std::string_view yaml_config,
+                                       EmbeddedGateway::SampleCallback on_sample) {
+  const gateway::ConfigResult parsed = gateway::parse_gateway_config(yaml_config);
+  if (!parsed) {
+    const auto& error = parsed.error();
+    throw std::invalid_argument("embedded gateway configuration" +
+                                (error.line > 0 ? ", line " + std::to_string(error.line) : std::string()) +
+                                ": " + error.message);
+  }
+  if (!parsed.config().has_ingress())
+    throw std::invalid_argument("embedded gateway configuration: `listen` is required");
+  gateway::GatewaySetup setup;
+  try {
+    setup = gateway::prepare(parsed.config());
+  } catch (const std::runtime_error& error) {
+    throw std::invalid_argument(std::string("embedded gateway configuration: ") + error.what());
+  }
+  setup.ingress->on_sample = std::move(on_sample);
+  return setup;
+}
+
+}  // namespace
+
+class EmbeddedGateway::Impl {
+ public:
+  Impl(std::string_view yaml_config, SampleCallback on_sample)
+      : setup_(prepare_embedded(yaml_config, std::move(on_sample))), gateway_(setup_) {
+    thread_ = std::thread([this] {
+      gateway::enter_realtime_mode(setup_.config);
+      try {
+        gateway_.run(stop_);
+      } catch (const std::exception& error) {
+        spdlog::error("embedded gateway stopped: {}", error.what());
+      }
+    });
+  }
+  ~Impl() { stop(); }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+
+  void stop() {
+    stop_.store(true, std::memory_order_relaxed);
+    if (thread_.joinable()) thread_.join();
+  }
+  Endpoint local_endpoint() const { return *gateway_.ingress_endpoint(); }
+
+ private:
+  gateway::GatewaySetup setup_;
+  gateway::Gateway gateway_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;  // last: started once everything it uses exists
+};
+
+EmbeddedGateway::EmbeddedGateway(std::string_view yaml_config, SampleCallback on_sample)
+    : impl_(std::make_unique<Impl>(yaml_config, std::move(on_sample))) {}
+EmbeddedGateway::~EmbeddedGateway() = default;
+EmbeddedGateway::EmbeddedGateway(EmbeddedGateway&&) noexcept = default;
+EmbeddedGateway& EmbeddedGateway::operator=(EmbeddedGateway&&) noexcept = default;
+
+Endpoint EmbeddedGateway::local_endpoint() const {
+  if (!impl_) throw std::logic_error("EmbeddedGateway::local_endpoint after stop()");
+  return impl_->local_endpoint();
+}
+
+void EmbeddedGateway::stop() { impl_.reset(); }
+
+}  // namespace rsg

@@ -1,0 +1,78 @@
+#include "flight_recorder.hpp"
+
+#include <cmath>
+#include <ctime>
+#include <stdexcept>
+
+#include "pcap_file.hpp"
+
+namespace rsg::gateway {
+namespace {
+
+std::string utc_stamp(std::chrono::system_clock::time_point now) {
+  const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
+  std::tm utc{};
+  gmtime_r(&seconds, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y%m%dT%H%M%S", &utc);
+  const auto millis =
+      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  char with_millis[40];
+  std::snprintf(with_millis, sizeof with_millis, "%s.%03dZ", text, static_cast<int>(millis));
+  return with_millis;
+}
+
+}  // namespace
+
+FlightRecorder::FlightRecorder(const Options& options, const Endpoint& listen, const DatagramBatch& batch)
+    : options_(options),
+      listen_(capture::endpoint_of(listen.address())),
+      slot_bytes_(batch.buffer_bytes()),
+      kept_capacity_(static_cast<std::size_t>(std::ceil(options.window.count() * options.expected_rate * 2)) +
+                     1) {
+  slots_ = kept_capacity_ + batch.capacity();
+  storage_.resize(slots_ * slot_bytes_);
+  entries_.resize(slots_);
+}
+
+void FlightRecorder::lend(DatagramBatch& batch) {
+  for (std::size_t i = 0; i < batch.capacity(); ++i)
+    batch.receive_into(i, {slot((next_ + i) % slots_), slot_bytes_});
+}
+
+void FlightRecorder::commit(const DatagramBatch& batch, std::size_t received,
+                            std::chrono::system_clock::time_point now) {
+  const auto time = std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch());
+  for (std::size_t i = 0; i < received; ++i) {
+    const DatagramBatch::Datagram datagram = batch[i];
+    Entry& entry = entries_[(next_ + i) % slots_];
+    entry.time = time;
+    entry.size = static_cast<std::uint32_t>(datagram.bytes.size());
+    entry.from = capture::endpoint_of(datagram.from.address());
+  }
+  next_ = (next_ + received) % slots_;
+  count_ = std::min(count_ + received, kept_capacity_);
+}
+
+FlightRecorder::Dump FlightRecorder::dump(std::string_view reason) {
+  const auto now = std::chrono::system_clock::now();
+  Dump result;
+  result.path = options_.dir / ("rsg_flight_" + utc_stamp(now) + "_" + std::to_string(++dumps_) + "_" +
+                                std::string(reason) + ".pcap");
+  capture::PcapWriter writer(result.path.string());
+  if (count_ > 0) {
+    const std::size_t oldest = (next_ + slots_ - count_) % slots_;
+    const auto newest = entries_[(next_ + slots_ - 1) % slots_].time;
+    const auto window = std::chrono::duration_cast<std::chrono::nanoseconds>(options_.window);
+    for (std::size_t i = 0; i < count_; ++i) {
+      const std::size_t index = (oldest + i) % slots_;
+      const Entry& entry = entries_[index];
+      if (newest - entry.time > window) continue;
+      if (writer.write({entry.time, entry.from, listen_, {slot(index), entry.size}})) ++result.frames;
+    }
+  }
+  writer.flush();
+  return result;
+}
+
+}  // namespace rsg::gateway

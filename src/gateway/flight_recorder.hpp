@@ -1,0 +1,74 @@
+// The gateway's flight recorder (--pcap-ring SECONDS --pcap-dir DIR): the raw datagrams of the last
+// seconds, kept in memory and written as a pcap file on request (SIGUSR1) or when the link goes
+// down, to answer "what did the robot send just before it failed".
+//
+// The ring is allocated at start-up, and the ingress receives straight into it
+// (DatagramBatch::receive_into): recording costs per frame no allocation and no copy, only a
+// timestamp and the sender's address. Only a dump allocates, and it runs on the ingress thread,
+// so frames wait in the socket's buffer while it writes.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <string_view>
+#include <vector>
+
+#include "rsg/transport/udp_socket.hpp"
+#include "udp_packet.hpp"
+
+namespace rsg::gateway {
+
+class FlightRecorder {
+ public:
+  struct Options {
+    std::chrono::duration<double> window{};  ///< how far back a dump reaches
+    double expected_rate = 1000;             ///< sizes the ring: twice this rate over the window
+    std::filesystem::path dir;               ///< where dumps go
+  };
+
+  struct Dump {
+    std::filesystem::path path;
+    std::size_t frames = 0;
+  };
+
+  /// `listen`: the gateway's address, the destination in the dumps. `batch`: the receive batch the
+  /// ring lends its slots to; one datagram of it takes at most `batch.buffer_bytes()`.
+  FlightRecorder(const Options& options, const Endpoint& listen, const DatagramBatch& batch);
+  FlightRecorder(const FlightRecorder&) = delete;
+  FlightRecorder& operator=(const FlightRecorder&) = delete;
+
+  /// Datagrams the ring holds at most (beyond the window when they arrive faster than planned).
+  std::size_t capacity() const { return kept_capacity_; }
+
+  /// Before a receive: the batch's datagrams will land in the ring's next free slots.
+  void lend(DatagramBatch& batch);
+  /// After it: the `received` datagrams of `batch` become the newest entries, seen at `now`.
+  void commit(const DatagramBatch& batch, std::size_t received, std::chrono::system_clock::time_point now);
+
+  /// Writes the datagrams of the last `window` before the newest one, oldest first, to
+  /// DIR/rsg_flight_<UTC time>_<N>_<reason>.pcap. Throws std::runtime_error when it cannot.
+  Dump dump(std::string_view reason);
+
+ private:
+  struct Entry {
+    std::chrono::nanoseconds time{};  // since the Unix epoch
+    std::uint32_t size = 0;
+    capture::UdpEndpoint from;
+  };
+
+  std::uint8_t* slot(std::size_t index) { return storage_.data() + index * slot_bytes_; }
+
+  Options options_;
+  capture::UdpEndpoint listen_;
+  std::size_t slot_bytes_;
+  std::size_t slots_;          // ring size: kept_capacity_ plus one batch being received into
+  std::size_t kept_capacity_;  // entries that are never lent out while they count
+  std::vector<std::uint8_t> storage_;
+  std::vector<Entry> entries_;
+  std::size_t next_ = 0;   // the slot the next datagram goes to
+  std::size_t count_ = 0;  // valid entries, ending just before next_
+  std::uint64_t dumps_ = 0;
+};
+
+}  // namespace rsg::gateway

@@ -1,0 +1,60 @@
+// The gateway's counters, and the two text forms of their snapshot: the `--stats-file` JSON and
+// the periodic log line. The DDS form is the GatewayStatus topic (status_publisher.hpp).
+//
+// Each counter has a single writer thread: ingress counters belong to the receive loop, egress
+// counters to the egress thread (which publishes them through relaxed atomics).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "rsg/wire/error.hpp"
+#include "sequence_tracker.hpp"
+
+namespace rsg::gateway {
+
+/// Per spec validation category (ErrorCategory::kTruncated first), `kNone` excluded.
+using InvalidCounts = std::array<std::uint64_t, kErrorCategoryCount>;
+
+constexpr std::size_t invalid_index(ErrorCategory category) { return static_cast<std::size_t>(category) - 1; }
+constexpr ErrorCategory category_at(std::size_t index) { return static_cast<ErrorCategory>(index + 1); }
+
+struct IngressCounters {
+  std::uint64_t received = 0;  ///< datagrams from allowed sources, valid or not
+  std::uint64_t published = 0;
+  std::uint64_t publish_failed = 0;  ///< valid frames DDS refused to write
+  std::uint64_t rejected_source = 0;
+  InvalidCounts invalid{};
+
+  std::uint64_t invalid_total() const;
+};
+
+struct EgressCounters {
+  std::uint64_t samples = 0;      ///< samples taken from the egress topic
+  std::uint64_t frames_sent = 0;  ///< datagrams sent, one per sample and destination
+  std::uint64_t unencodable = 0;  ///< samples that do not describe a valid frame
+  std::uint64_t send_failed = 0;
+};
+
+struct GatewayStats {
+  IngressCounters ingress;
+  std::uint32_t state_readers = 0;   ///< readers matched by the RobotState writer
+  std::uint32_t egress_writers = 0;  ///< writers matched by the egress reader
+  SequenceTracker::Counts sequence;
+  EgressCounters egress;
+  double rate_hz = 0;  ///< valid frames per second over the last status period
+  bool link_up = false;
+  std::string source;  ///< "HOST:PORT" of the last valid frame, empty before the first
+};
+
+/// One JSON object; counter names as in GatewayStatus.idl, `invalid` keyed by category name.
+std::string to_json(const GatewayStats& stats);
+
+/// One line for the periodic log.
+std::string summary_line(const GatewayStats& stats);
+
+/// "bad_crc=3 truncated=1": the non-zero counts of `counts`, in category order.
+std::string format_invalid(const InvalidCounts& counts);
+
+}  // namespace rsg::gateway

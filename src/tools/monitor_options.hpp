@@ -1,0 +1,50 @@
+// The command-line options every tool that watches a gateway shares (rsg_record, rsg_view): where
+// to read (domain, topics, partitions, view, reader QoS), which profiles to load, and discovery.
+// A tool's own Options derive from MonitorOptions, so each option is declared and documented once.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "monitor_readers.hpp"
+#include "rsg/dds/discovery.hpp"
+#include "rsg/dds/discovery_cli.hpp"
+#include "rsg/dds/profiles.hpp"
+
+namespace rsg::tools {
+
+struct MonitorOptions {
+  int domain = 0;
+  std::string topic = "robot_state";
+  std::string status_topic = "rsg_gateway_status";
+  std::vector<std::string> partitions;
+  std::string view_profile;
+  std::string qos_profile = kLoggerReaderProfile;  // a watcher misses nothing a reliable writer kept
+  std::vector<std::string> profiles;
+  std::string participant_profile = "rsg_participant";
+  DiscoveryOptions discovery;
+
+  MonitorTopics topics() const { return {topic, status_topic, partitions, view_profile, qos_profile}; }
+};
+
+/// `without_status` completes the --status-topic help: what an empty topic name means to the tool.
+inline void add_monitor_options(CLI::App& app, MonitorOptions& options, const std::string& without_status) {
+  app.add_option("--domain", options.domain, "DDS domain id")
+      ->check(CLI::Range(0, 232))
+      ->capture_default_str();
+  app.add_option("--topic", options.topic, "RobotState topic")->capture_default_str();
+  app.add_option("--status-topic", options.status_topic, "GatewayStatus topic; \"\" " + without_status)
+      ->capture_default_str();
+  app.add_option("--partition", options.partitions, "DDS partition (repeatable; default: none)");
+  app.add_option("--view", options.view_profile,
+                 "View profile, e.g. view_joints: only samples carrying its groups");
+  app.add_option("--qos", options.qos_profile, "Reader QoS profile")->capture_default_str();
+  app.add_option("--profiles", options.profiles, "XML profile file or directory (repeatable)")
+      ->default_str(default_profiles_dir().string());
+  app.add_option("--participant-profile", options.participant_profile, "XML participant profile")
+      ->capture_default_str();
+  add_discovery_options(app, options.discovery);
+}
+
+}  // namespace rsg::tools

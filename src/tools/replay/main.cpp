@@ -1,0 +1,277 @@
+// rsg_replay: plays the RobotState messages of an MCAP recording back at their original timing,
+// as raw frames to a UDP address (what the robot sent: byte for byte the frames the gateway
+// received) or as DDS samples.
+//
+// Exit status: 0 when the file was played (a killed recording's file too: up to its last whole
+// chunk, with a warning) or on SIGINT/SIGTERM; 1 when the file cannot be read or is damaged, or
+// a send fails; 2 on usage errors.
+#include <CLI/CLI.hpp>
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <iostream>
+#include <optional>
+#include <thread>
+#include <unordered_set>
+
+#include "mcap_reader.hpp"
+#include "recording.hpp"
+#include "rsg/dds/discovery_cli.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "rsg/dds/robot_state.hpp"
+#include "rsg/transport/udp_socket.hpp"
+#include "stop_on_signal.hpp"
+#include "tool_main.hpp"
+
+namespace {
+
+namespace fdds = eprosima::fastdds::dds;
+using Clock = std::chrono::steady_clock;
+using rsg::tools::StopOnSignal;
+
+using namespace rsg::tools;  // exit statuses
+
+// Sleeps are cut into slices so that a stop request ends a long pause promptly.
+constexpr auto kLongestSleep = std::chrono::milliseconds(50);
+
+struct Options {
+  std::string file;
+  std::string to;
+  std::optional<int> domain;
+  std::string topic = "robot_state";
+  std::vector<std::string> partitions;
+  std::string writer_profile = "rsg_state_writer";
+  std::vector<std::string> profiles;
+  std::string participant_profile = "rsg_participant";
+  rsg::DiscoveryOptions discovery;
+  int wait_for_readers = 0;
+  double speed = 1;
+  bool loop = false;
+};
+
+/// Where the samples go: raw frames over UDP, or DDS samples.
+class Output {
+ public:
+  virtual ~Output() = default;
+  /// False when the sample cannot be sent (the reason is on stderr).
+  virtual bool send(const rsg::RobotState& sample) = 0;
+  /// After the last send: returns once what was sent has left (or could not).
+  virtual void finish() {}
+};
+
+class UdpOutput final : public Output {
+ public:
+  explicit UdpOutput(const rsg::Endpoint& to) : to_(to), socket_(rsg::UdpSocket::for_sending_to(to)) {}
+  bool send(const rsg::RobotState& sample) override {
+    const rsg::EncodeResult frame = codec_.encode(sample, frame_);
+    if (!frame) {
+      ++unencodable;  // a sample no valid frame could have produced (written by another app)
+      return true;
+    }
+    if (socket_.send_to({frame_.data(), frame.size}, to_)) return true;
+    std::cerr << "rsg_replay: cannot send to " << to_.to_string() << ": " << std::strerror(errno) << "\n";
+    return false;
+  }
+  std::uint64_t unencodable = 0;
+
+ private:
+  rsg::Endpoint to_;
+  rsg::UdpSocket socket_;
+  rsg::RobotStateCodec codec_;
+  std::array<std::uint8_t, rsg::kMaxFrameBytes> frame_{};
+};
+
+class DdsOutput final : public Output {
+ public:
+  DdsOutput(const Options& options)
+      : participant_(*options.domain, options.participant_profile, options.discovery),
+        writer_(participant_.publisher(options.partitions)
+                    ->create_datawriter_with_profile(participant_.robot_state_topic(options.topic),
+                                                     options.writer_profile)) {
+    if (writer_ == nullptr)
+      throw std::runtime_error("cannot create a writer with profile '" + options.writer_profile + "'");
+  }
+  bool send(const rsg::RobotState& sample) override {
+    if (writer_->write(const_cast<rsg::RobotState*>(&sample))) return true;
+    std::cerr << "rsg_replay: the DDS writer refused a sample\n";
+    return false;
+  }
+  fdds::DataWriter& writer() { return *writer_; }
+  /// A reliable writer deleted right after its last write takes the unacknowledged samples with
+  /// it, and a reader that matched a moment after the writer did never gets them: wait (bounded)
+  /// until every matched reader has acknowledged.
+  void finish() override {
+    if (writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0)) != ReturnCode_t::RETCODE_OK)
+      std::cerr << "rsg_replay: not every reader acknowledged the last samples within 5 s\n";
+  }
+
+ private:
+  rsg::Participant participant_;
+  fdds::DataWriter* writer_;  // owned by participant_
+};
+
+/// Sends each RobotState message when it is due: publish times relative to the first message,
+/// divided by the speed, on the steady clock.
+class Player final : public rsg::mcap::RecordVisitor {
+ public:
+  Player(Output& output, double speed, const std::atomic<bool>& stop)
+      : output_(output), speed_(speed), stop_(stop) {}
+
+  void on_channel(const rsg::mcap::Channel& channel) override {
+    if (state_schemas_.contains(channel.schema_id) && channel.message_encoding == "cdr")
+      state_channels_.insert(channel.id);
+  }
+  void on_schema(const rsg::mcap::Schema& schema) override {
+    if (rsg::record::is_robot_state_schema(schema.name)) state_schemas_.insert(schema.id);
+  }
+  bool on_message(const rsg::mcap::Message& message) override {
+    if (!state_channels_.contains(message.channel_id)) return !stop_;
+    if (!serializer_.deserialize(message.data.bytes, sample_)) {
+      ++undecodable;
+      return !stop_;
+    }
+    if (!first_time_) {
+      first_time_ = message.publish_time;
+      start_ = Clock::now();
+    }
+    const double offset_ns =
+        static_cast<double>(static_cast<std::int64_t>(message.publish_time - *first_time_)) / speed_;
+    wait_until(start_ + std::chrono::nanoseconds(static_cast<std::int64_t>(std::max(0.0, offset_ns))));
+    if (stop_) return false;
+    if (!output_.send(sample_)) {
+      failed = true;
+      return false;
+    }
+    ++sent;
+    return true;
+  }
+
+  /// Starts the timeline again (for --loop).
+  void restart() { first_time_.reset(); }
+
+  std::uint64_t sent = 0, undecodable = 0;
+  bool failed = false;
+
+ private:
+  void wait_until(Clock::time_point due) const {
+    while (!stop_) {
+      const auto left = due - Clock::now();
+      if (left <= Clock::duration::zero()) return;
+      std::this_thread::sleep_for(std::min<Clock::duration>(left, kLongestSleep));
+    }
+  }
+
+  Output& output_;
+  double speed_;
+  const std::atomic<bool>& stop_;
+  std::unordered_set<std::uint16_t> state_schemas_, state_channels_;
+  rsg::record::CdrSerializer serializer_;
+  rsg::RobotState sample_;
+  std::optional<std::uint64_t> first_time_;
+  Clock::time_point start_;
+};
+
+void add_options(CLI::App& app, Options& options) {
+  app.add_option("file", options.file, "MCAP file written by rsg_record")->required();
+  auto* to = app.add_option("--to", options.to, "Send raw frames to HOST:PORT (as the robot did)");
+  auto* domain = app.add_option("--domain", options.domain, "Publish DDS samples on this domain instead")
+                     ->check(CLI::Range(0, 232));
+  to->excludes(domain);
+  app.add_option("--topic", options.topic, "RobotState topic (with --domain)")->capture_default_str();
+  app.add_option("--partition", options.partitions, "DDS partition (with --domain; repeatable)");
+  app.add_option("--writer-profile", options.writer_profile, "DataWriter profile (with --domain)")
+      ->capture_default_str();
+  app.add_option("--wait-for-readers", options.wait_for_readers,
+                 "With --domain: wait up to 10 s until this many readers have matched before playing");
+  app.add_option("--profiles", options.profiles, "XML profile file or directory (repeatable)")
+      ->default_str(rsg::default_profiles_dir().string());
+  app.add_option("--participant-profile", options.participant_profile, "XML participant profile")
+      ->capture_default_str();
+  rsg::add_discovery_options(app, options.discovery);
+  app.add_option("--speed", options.speed, "Play this many times faster than recorded")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_flag("--loop", options.loop, "Play the file again and again until SIGINT/SIGTERM");
+}
+
+void wait_for_readers(fdds::DataWriter& writer, int readers, const std::atomic<bool>& stop) {
+  const auto deadline = Clock::now() + std::chrono::seconds(10);
+  fdds::PublicationMatchedStatus matched;
+  while (!stop && Clock::now() < deadline &&
+         writer.get_publication_matched_status(matched) == ReturnCode_t::RETCODE_OK &&
+         matched.current_count < readers)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  if (matched.current_count < readers)
+    std::cerr << "rsg_replay: only " << matched.current_count << " of " << readers
+              << " readers matched; playing anyway\n";
+}
+
+int run(const Options& options) {
+  StopOnSignal::block_stop_signals();
+  std::atomic<bool> stop = false;
+  StopOnSignal stop_on_signal([&stop] { stop = true; });
+  const rsg::mcap::MappedFile file(options.file);
+
+  std::unique_ptr<Output> output;
+  if (options.domain) {
+    rsg::load_profiles(options.profiles, options.participant_profile);
+    auto dds = std::make_unique<DdsOutput>(options);
+    wait_for_readers(dds->writer(), options.wait_for_readers, stop);
+    output = std::move(dds);
+  } else {
+    output = std::make_unique<UdpOutput>(rsg::Endpoint::parse(options.to));
+  }
+
+  Player player(*output, options.speed, stop);
+  rsg::mcap::ScanResult result;
+  using Status = rsg::mcap::ScanResult::Status;
+  // A killed recording loops too (its readable part); a pass that sent nothing ends the loop.
+  std::uint64_t sent_before = 0;
+  do {
+    sent_before = player.sent;
+    player.restart();
+    result = rsg::mcap::scan(file.bytes(), player);
+  } while (options.loop && !stop && !player.failed &&
+           (result.status == Status::complete || result.status == Status::truncated) &&
+           player.sent > sent_before);
+
+  output->finish();
+  std::cerr << "rsg_replay: sent " << player.sent << " samples";
+  if (player.undecodable > 0)
+    std::cerr << ", skipped " << player.undecodable << " that do not decode as RobotState";
+  if (auto* udp = dynamic_cast<UdpOutput*>(output.get()); udp && udp->unencodable > 0)
+    std::cerr << ", skipped " << udp->unencodable << " that no valid frame describes";
+  std::cerr << "\n";
+  if (result.status == Status::truncated)
+    std::cerr << "rsg_replay: warning: " << options.file
+              << " ends early (a recorder that was killed?): " << result.error << " at byte " << result.offset
+              << "; played everything before it\n";
+  if (result.status == Status::malformed) {
+    std::cerr << "rsg_replay: " << options.file << " is damaged at byte " << result.offset << ": "
+              << result.error << "\n";
+    return kExitFailure;
+  }
+  return player.failed ? kExitFailure : kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Plays an rsg_record MCAP file back as raw frames (--to) or DDS samples (--domain).",
+               "rsg_replay"};
+  app.footer(
+      "Exit status: 0 when played (a killed recording up to its last whole chunk, with a warning) or on "
+      "SIGINT/SIGTERM, 1 when the file cannot be read or is damaged or a send fails, 2 usage error.");
+  Options options;
+  add_options(app, options);
+  if (const auto stop = parse_command_line(app, argc, argv)) return *stop;
+  if (options.to.empty() && !options.domain) {
+    app.exit(CLI::RequiredError("--to or --domain"));
+    return kExitUsage;
+  }
+  return run_reporting_errors("rsg_replay", [&] { return run(options); });
+}

@@ -1,0 +1,185 @@
+// rsg_view: subscribes to RobotState (whole or through a view) and GatewayStatus like any DDS
+// reader, and serves them on one port: the Foxglove WebSocket protocol for Foxglove, PlotJuggler
+// and Lichtblick, and a live page at http://HOST:PORT/ for an operator with no other tool.
+//
+// A separate process so that the gateway stays lean: a slow browser costs this process at most its
+// own bounded queues, never the gateway or the DDS reader.
+//
+// Exit status: 0 on SIGINT/SIGTERM, 1 when the port cannot be opened or DDS fails, 2 on usage
+// errors (including unknown profiles).
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <sstream>
+
+#include "monitor_options.hpp"
+#include "monitor_readers.hpp"
+#include "recording.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "rsg/dds/views.hpp"
+#include "rsg/transport/udp_socket.hpp"
+#include "server.hpp"
+#include "stop_on_signal.hpp"
+#include "tool_main.hpp"
+#include "view_channels.hpp"
+#include "web_assets.hpp"
+
+namespace {
+
+namespace fdds = eprosima::fastdds::dds;
+using rsg::tools::StopOnSignal;
+
+using namespace rsg::tools;  // exit statuses
+
+constexpr auto kWakeUp = std::chrono::milliseconds(20);
+constexpr auto kPageRepeat = std::chrono::seconds(1);
+
+struct Options : rsg::tools::MonitorOptions {
+  std::string listen = "127.0.0.1:8765";
+  double page_rate_hz = 30;
+  std::string chart_js = RSG_CHART_JS;
+  rsg::view::ServerOptions server;
+};
+
+std::uint64_t now_ns() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch())
+                                        .count());
+}
+
+rsg::view::Payload payload_of(std::span<const std::uint8_t> bytes) {
+  return std::make_shared<const std::vector<std::uint8_t>>(bytes.begin(), bytes.end());
+}
+rsg::view::Payload payload_of(const std::string& text) {
+  return std::make_shared<const std::vector<std::uint8_t>>(text.begin(), text.end());
+}
+
+void add_options(CLI::App& app, Options& options) {
+  app.add_option("--listen", options.listen,
+                 "HOST:PORT of the WebSocket and HTTP server (0.0.0.0 opens it to other hosts)")
+      ->capture_default_str();
+  rsg::tools::add_monitor_options(app, options, "serves none");
+  app.add_option("--max-clients", options.server.max_clients, "WebSocket clients served at once")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
+  app.add_option("--queue-depth", options.server.queue_depth,
+                 "Messages queued per client and subscription; a slower client loses its oldest")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  app.add_option("--page-rate", options.page_rate_hz, "Updates per second of the page's summary channel")
+      ->check(CLI::Range(1.0, 1000.0))
+      ->capture_default_str();
+  app.add_option("--chart-js", options.chart_js, "Chart.js file the page loads (Debian's libjs-chart.js)")
+      ->capture_default_str();
+}
+
+std::vector<rsg::view::WebFile> web_files(const Options& options) {
+  std::vector<rsg::view::WebFile> files{
+      {"/", "text/html; charset=utf-8", std::string(rsg::view::web::kIndexHtml)},
+      {"/app.js", "text/javascript; charset=utf-8", std::string(rsg::view::web::kAppJs)},
+  };
+  std::ifstream in(options.chart_js, std::ios::binary);
+  if (!in) {
+    std::cerr << "rsg_view: warning: cannot read " << options.chart_js
+              << " (install libjs-chart.js or pass --chart-js): the page shows numbers but no plots\n";
+    return files;
+  }
+  std::ostringstream body;
+  body << in.rdbuf();
+  files.push_back({"/chart.js", "text/javascript; charset=utf-8", body.str()});
+  return files;
+}
+
+void split_listen(const std::string& text, rsg::view::ServerOptions& server) {
+  const rsg::Endpoint endpoint = rsg::Endpoint::parse(text);  // throws std::invalid_argument
+  std::string host = endpoint.to_string();
+  host.resize(host.rfind(':'));
+  if (host.size() >= 2 && host.front() == '[') host = host.substr(1, host.size() - 2);
+  server.host = host;
+  server.port = endpoint.port();
+}
+
+int run(const Options& options) {
+  StopOnSignal::block_stop_signals();
+  rsg::view::ChannelSet channels(options.topic, options.status_topic);
+  rsg::view::Server server(options.server, channels.channels(), web_files(options));
+  std::cerr << "rsg_view: serving ws://" << options.server.host << ":" << server.port() << " and http://"
+            << options.server.host << ":" << server.port() << "/\n";
+
+  rsg::Participant participant(options.domain, options.participant_profile, options.discovery);
+  rsg::tools::MonitorReaders readers(participant, options.topics());
+  StopOnSignal stop_on_signal([&readers] { readers.request_stop(); });
+
+  const auto page_period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(1.0 / options.page_rate_hz));
+  auto next_page = std::chrono::steady_clock::now();
+  rsg::record::CdrSerializer serializer;
+  rsg::view::PageSummary summary;
+  rsg::RobotState state;
+  rsg::GatewayStatus status;
+  fdds::SampleInfo info;
+  bool summary_pending = false;
+  while (!readers.stop_requested()) {
+    readers.wait(kWakeUp);
+    while (readers.state().take_next_sample(&state, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      const std::uint64_t time = now_ns();
+      const auto cdr = payload_of(serializer.serialize(state));
+      for (const auto channel : channels.robot_state_cdr()) server.publish(channel, time, cdr);
+      if (const auto transform = rsg::view::frame_transform_json(state, time))
+        server.publish(channels.transform(), time, payload_of(*transform));
+      summary.add(state);
+      summary_pending = true;
+    }
+    while (readers.status() != nullptr &&
+           readers.status()->take_next_sample(&status, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      const std::uint64_t time = now_ns();
+      const auto cdr = payload_of(serializer.serialize(status));
+      for (const auto channel : channels.status_cdr()) server.publish(channel, time, cdr);
+      server.publish(channels.status_json(), time, payload_of(rsg::view::status_json(status)));
+    }
+    // Also once a second when nothing arrives, so that a page opened after the stream stopped shows
+    // its last state.
+    const auto now = std::chrono::steady_clock::now();
+    if ((summary_pending && now >= next_page) || (summary.samples() > 0 && now >= next_page + kPageRepeat)) {
+      next_page = now + page_period;
+      summary_pending = false;
+      server.publish(channels.summary(), now_ns(), payload_of(summary.json(server.dropped())));
+    }
+  }
+  std::cerr << "rsg_view: received " << summary.samples() << " states; dropped " << server.dropped()
+            << " messages for slow clients\n";
+  const auto counts = server.channel_counts();  // in the order of channels.channels()
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    const auto& channel = channels.channels()[i];
+    std::cerr << "rsg_view: channel " << channel.id << " " << channel.topic << " (" << channel.schema_name
+              << ", " << channel.schema_encoding << "): published " << counts[i].published << ", dropped "
+              << counts[i].dropped << "\n";
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Serves RobotState and GatewayStatus to Foxglove, PlotJuggler and a live web page.",
+               "rsg_view"};
+  app.footer(
+      "Exit status: 0 on SIGINT/SIGTERM, 1 when the port cannot be opened or DDS fails, 2 usage error.");
+  Options options;
+  add_options(app, options);
+  if (const auto stop = parse_command_line(app, argc, argv)) return *stop;
+  try {
+    split_listen(options.listen, options.server);
+  } catch (const std::exception& error) {
+    std::cerr << "rsg_view: --listen: " << error.what() << '\n';
+    return kExitUsage;
+  }
+  if (const auto stop = load_profiles("rsg_view", options.profiles, options.participant_profile))
+    return *stop;
+  return run_reporting_errors("rsg_view", [&] { return run(options); });
+}

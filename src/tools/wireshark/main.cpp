@@ -1,0 +1,109 @@
+// rsg_wireshark_lua: writes the Wireshark dissector tools/wireshark/rsg_sendbuf.lua from its template
+// and the field table, so that the dissector names, sizes and orders fields exactly as the codec does.
+//
+//   rsg_wireshark_lua TEMPLATE OUTPUT
+//
+// The template holds the dissector's logic; the line @RSG_GENERATED_TABLES@ becomes the tables.
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <string_view>
+
+#include "rsg/wire/error.hpp"
+#include "rsg/wire/error_flags.hpp"
+#include "rsg/wire/field_docs.hpp"
+#include "rsg/wire/field_table.hpp"
+#include "rsg/wire/frame.hpp"
+
+namespace {
+
+// The gateway's port in the README's examples and the Docker image (EXPOSE 17000/udp).
+constexpr unsigned kDocumentedGatewayPort = 17000;
+constexpr std::string_view kPlaceholder = "@RSG_GENERATED_TABLES@";
+
+std::string_view type_name(rsg::ElementType type) {
+  switch (type) {
+    case rsg::ElementType::kFloat64:
+      return "float64";
+    case rsg::ElementType::kErrorSet:
+      return "error_set";
+    case rsg::ElementType::kUInt8:
+      return "uint8";
+    case rsg::ElementType::kUInt64:
+      return "uint64";
+  }
+  return "";
+}
+
+/// A Lua string literal; the table's texts are plain ASCII without quotes, but stay safe anyway.
+std::string quoted(std::string_view text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + '"';
+}
+
+std::string tables() {
+  std::ostringstream lua;
+  lua << "-- Tables generated from include/rsg/wire/{field_table,field_docs,error_flags,error}.hpp.\n";
+  lua << "local DEFAULT_PORT = " << kDocumentedGatewayPort << "\n";
+  lua << "local REQUEST_TYPE = " << unsigned{rsg::kRequestType} << "\n";
+  lua << "local GROUP_COUNT = " << rsg::kGroupCount << "\n";
+  lua << "local MAX_ROBOT_MODE = " << unsigned{rsg::kMaxRobotMode} << "\n";
+  lua << "local ERROR_FLAG_COUNT = " << rsg::kErrorFlagCount << "\n";
+  lua << "-- Validation categories in the order the spec checks them.\nlocal ERROR_CATEGORIES = {";
+  for (std::size_t i = 1; i < rsg::kErrorCategoryNames.size(); ++i)
+    lua << (i == 1 ? " " : ", ") << quoted(rsg::kErrorCategoryNames[i]);
+  lua << " }\n";
+  lua << "-- The field table in field-index order (the order of the data section).\nlocal FIELDS = {\n";
+  for (const rsg::FieldInfo& field : rsg::kFields) {
+    const rsg::FieldDoc doc = rsg::field_doc(field.id());
+    char mask[8];
+    std::snprintf(mask, sizeof mask, "0x%02x", unsigned{field.mask});
+    lua << "  { name = " << quoted(field.name) << ", index = " << unsigned{field.index}
+        << ", group = " << unsigned{field.group} << ", mask = " << mask
+        << ", type = " << quoted(type_name(field.type)) << ", count = " << unsigned{field.count}
+        << ", bytes = " << field.wire_bytes << ", rows = " << doc.matrix_rows
+        << ", unit = " << quoted(doc.unit) << ", meaning = " << quoted(doc.meaning) << " },\n";
+  }
+  lua << "}\n-- Error-set bit -> flag name.\nlocal ERROR_FLAGS = {\n";
+  for (std::size_t i = 0; i < rsg::kErrorFlagNames.size(); ++i)
+    lua << "  [" << i << "] = " << quoted(rsg::kErrorFlagNames[i]) << ",\n";
+  lua << "}\nlocal ROBOT_MODES = {";
+  for (std::size_t i = 0; i < rsg::kRobotModeNames.size(); ++i)
+    lua << (i == 0 ? " " : ", ") << "[" << i << "] = " << quoted(rsg::kRobotModeNames[i]);
+  lua << " }";
+  return lua.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::cerr << "usage: rsg_wireshark_lua TEMPLATE OUTPUT\n";
+    return 2;
+  }
+  std::ifstream in(argv[1], std::ios::binary);
+  if (!in) {
+    std::cerr << "error: cannot read '" << argv[1] << "'\n";
+    return 1;
+  }
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::size_t at = text.find(kPlaceholder);
+  if (at == std::string::npos) {
+    std::cerr << "error: '" << argv[1] << "' has no " << kPlaceholder << '\n';
+    return 1;
+  }
+  text.replace(at, kPlaceholder.size(), tables());
+  std::ofstream out(argv[2], std::ios::binary | std::ios::trunc);
+  out << text;
+  if (!out.flush()) {
+    std::cerr << "error: cannot write '" << argv[2] << "'\n";
+    return 1;
+  }
+  return 0;
+}

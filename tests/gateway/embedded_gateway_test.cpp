@@ -1,0 +1,151 @@
+// rsg::EmbeddedGateway: the callback gets exactly the samples a reader in another participant
+// receives over the network (the same frames, byte for byte, in the same order), never a rejected
+// frame, and nothing after stop(); an unusable configuration throws before anything starts.
+#include "rsg/gateway/embedded_gateway.hpp"
+
+#include <fastrtps/attributes/LibrarySettingsAttributes.h>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+#include <mutex>
+#include <random>
+#include <thread>
+
+#include "random_state.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/robot_state.hpp"
+
+namespace rsg {
+namespace {
+
+using namespace std::chrono_literals;
+using Bytes = std::vector<std::uint8_t>;
+
+constexpr std::size_t kFrames = 300;
+constexpr std::size_t kCorruptEvery = 10;
+
+std::string config(int domain, const std::string& topic) {
+  return "listen: 127.0.0.1:0\nlog-level: warn\ndomain: " + std::to_string(domain) + "\ntopic: " + topic +
+         "\nstatus-topic: " + topic + "_status\nprofiles: " RSG_PROFILES_DIR "\n";
+}
+
+Bytes frame_of(const RobotState& sample) {
+  Bytes frame(kMaxFrameBytes);
+  const EncodeResult encoded = to_frame(sample, frame);
+  EXPECT_TRUE(encoded);
+  frame.resize(encoded.size);
+  return frame;
+}
+
+class EmbeddedGatewayTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    // The reader must get its samples over the network, as a reader in another process would.
+    eprosima::fastrtps::LibrarySettingsAttributes settings;
+    settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+    eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
+  }
+  const int domain_ = static_cast<int>(::getpid() % 200 + 10);
+};
+
+TEST_F(EmbeddedGatewayTest, CallbackSeesExactlyWhatARemoteReaderReceives) {
+  std::mutex mutex;
+  std::vector<Bytes> from_callback;
+  EmbeddedGateway gateway(config(domain_, "embedded_same"), [&](const RobotState& sample) {
+    const std::lock_guard lock(mutex);
+    from_callback.push_back(frame_of(sample));
+  });
+
+  Participant participant(domain_, "rsg_participant");
+  fdds::DataReaderQos qos = fdds::DATAREADER_QOS_DEFAULT;
+  qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+  qos.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
+  qos.data_sharing().off();  // the network, not shared memory
+  fdds::DataReader* reader =
+      participant.subscriber()->create_datareader(participant.robot_state_topic("embedded_same"), qos);
+  ASSERT_NE(reader, nullptr);
+  fdds::SubscriptionMatchedStatus matched;
+  for (int i = 0; i < 1000 && matched.current_count == 0; ++i) {
+    std::this_thread::sleep_for(10ms);
+    reader->get_subscription_matched_status(matched);
+  }
+  ASSERT_EQ(matched.current_count, 1) << "the embedded gateway's writer never matched";
+
+  std::mt19937_64 rng(3);
+  std::vector<Bytes> sent;
+  const Endpoint to = gateway.local_endpoint();
+  UdpSocket robot = UdpSocket::for_sending_to(to);
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    StateValues values = test::random_state(rng);
+    values.packet_number = static_cast<std::uint8_t>(i % kPacketNumberModulo);
+    Bytes frame(kMaxFrameBytes);
+    frame.resize(
+        encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), frame).size);
+    if (i % kCorruptEvery == kCorruptEvery - 1)
+      frame.back() ^= 0xFF;  // rejected: neither the callback nor DDS may see it
+    else
+      sent.push_back(frame);
+    ASSERT_TRUE(robot.send_to(frame, to));
+    std::this_thread::sleep_for(200us);  // no burst beyond the socket buffer
+  }
+
+  std::vector<Bytes> from_reader;
+  RobotState sample;
+  fdds::SampleInfo info;
+  for (int i = 0; i < 1000 && from_reader.size() < sent.size(); ++i) {
+    while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) from_reader.push_back(frame_of(sample));
+    if (from_reader.size() < sent.size()) std::this_thread::sleep_for(10ms);
+  }
+  participant.subscriber()->delete_datareader(reader);
+  gateway.stop();
+
+  const std::lock_guard lock(mutex);
+  ASSERT_EQ(from_callback.size(), sent.size());
+  ASSERT_EQ(from_reader.size(), sent.size());
+  for (std::size_t i = 0; i < sent.size(); ++i) {
+    EXPECT_EQ(from_callback[i], sent[i]) << "callback sample " << i << " is not the frame sent";
+    EXPECT_EQ(from_reader[i], from_callback[i]) << "sample " << i << ": the reader got something else";
+  }
+}
+
+TEST_F(EmbeddedGatewayTest, NoCallbackAfterStop) {
+  std::atomic<int> calls{0};
+  EmbeddedGateway gateway(config(domain_, "embedded_stop"), [&](const RobotState&) { ++calls; });
+  const Endpoint to = gateway.local_endpoint();
+  gateway.stop();
+  gateway.stop();  // idempotent
+  EXPECT_THROW(gateway.local_endpoint(), std::logic_error);
+  StateValues values;
+  values.selection = Selection::all();
+  Bytes frame(kMaxFrameBytes);
+  frame.resize(encode(0, values.selection, values.storage(), StateValues::layout(), frame).size);
+  UdpSocket robot = UdpSocket::for_sending_to(to);
+  robot.send_to(frame, to);  // the port is closed: may be refused
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(calls.load(), 0);
+}
+
+TEST_F(EmbeddedGatewayTest, UnusableConfigurationThrowsNamingTheProblem) {
+  const auto message_of = [](const std::string& yaml) {
+    try {
+      EmbeddedGateway gateway(yaml, [](const RobotState&) {});
+    } catch (const std::invalid_argument& error) {
+      return std::string(error.what());
+    }
+    return std::string("no exception");
+  };
+  EXPECT_NE(message_of("domain: 3\n").find("`listen` is required"), std::string::npos);
+  EXPECT_NE(message_of("listen: 127.0.0.1:0\nexpected-rate: -1\n").find("expected-rate"), std::string::npos);
+  EXPECT_NE(message_of("listen: 127.0.0.1:0\nno-such-key: 1\n").find("line 2"), std::string::npos);
+  EXPECT_NE(
+      message_of("listen: 127.0.0.1:0\nprofiles: " RSG_PROFILES_DIR "\nwriter-profile: nope\n").find("nope"),
+      std::string::npos);
+}
+
+}  // namespace
+}  // namespace rsg

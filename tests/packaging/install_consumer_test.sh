@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# `make install` into a scratch prefix, then build and run a project outside the tree that finds the
+# installed package with find_package(rsg): the public headers, libraries and config are complete.
+set -euo pipefail
+source_dir=${1:?usage: install_consumer_test.sh SOURCE_DIR BUILD_DIR}
+build_dir=${2:?usage: install_consumer_test.sh SOURCE_DIR BUILD_DIR}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+cmake --install "$build_dir" --prefix "$work/prefix" > "$work/install.log"
+# Only the public layers are installed: no gateway or simulator internals (the embedded gateway's
+# one header is public).
+installed=$(cd "$work/prefix/include/rsg" && find . -name '*.hpp' | sort)
+for header in $installed; do
+  case "$header" in ./wire/* | ./transport/* | ./dds/* | ./gateway/embedded_gateway.hpp) ;; *) echo "FAIL: internal header installed: $header"; exit 1 ;; esac
+done
+for tool in rsg_gateway rsg_sim rsg_echo rsg_frame rsg_record rsg_replay; do
+  [[ -x "$work/prefix/bin/$tool" ]] || { echo "FAIL: $tool not installed"; exit 1; }
+done
+[[ -f "$work/prefix/share/rsg/idl/RobotState.idl" ]] || { echo "FAIL: IDL not installed"; exit 1; }
+
+cmake -S "$source_dir/tests/packaging/consumer" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" \
+  > "$work/configure.log" || { cat "$work/configure.log"; exit 1; }
+cmake --build "$work/build" > "$work/build.log" 2>&1 || { cat "$work/build.log"; exit 1; }
+"$work/build/consumer"
+# The embedded gateway from the installed package, with the installed profiles, on its own domain.
+"$work/build/embedded_consumer" "$work/prefix/share/rsg/xml_profiles" $(($$ % 200 + 10))
+echo "install_consumer: OK ($(echo "$installed" | wc -w) public headers)"

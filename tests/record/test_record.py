@@ -1,0 +1,300 @@
+"""rsg_record and rsg_replay with real components: rsg_sim -> rsg_gateway -> rsg_record, the file
+read by the reference MCAP reader (@mcap/core, in check_recording.mjs), and played back through a
+gateway to rsg_echo. Each case is one ctest test (record.<case>), in its own DDS domain and ports.
+
+    test_record.py --bin build/bin --case reference_reader
+"""
+
+import json
+import os
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "integration"))
+from harness import (UdpRelay, check, free_udp_port, main, read_json_lines, wait_for,  # noqa: E402
+                     wait_for_stats)
+
+CASE = sys.argv[sys.argv.index("--case") + 1]
+del sys.argv[sys.argv.index("--case"):sys.argv.index("--case") + 2]
+
+
+def node_check(h, mcap, *args):
+    """Runs check_recording.mjs; fails the test (never skips) when Node or its packages are missing."""
+    node = shutil.which("node")
+    check(node is not None, "node is not installed: run `make deps`")
+    check((HERE / "node_modules" / "@mcap" / "core").is_dir(),
+          "tests/record/node_modules is missing: run `make deps` (npm ci --prefix tests/record)")
+    result = subprocess.run([node, str(HERE / "check_recording.mjs"), str(mcap), *map(str, args)],
+                            capture_output=True, text=True, timeout=60)
+    print(f"[{h.name}] check_recording: {result.stdout.strip()} {result.stderr.strip()}", flush=True)
+    check(result.returncode == 0, f"the reference reader rejected {mcap}: {result.stderr.strip()}")
+    return json.loads(result.stdout)
+
+
+def recorder(h, label, out, *flags, preexec_fn=None):
+    argv = [h.binary("rsg_record"), "--domain", str(h.domain), "--out", str(out), *flags]
+    print(f"[{h.name}] start {label}: {' '.join(argv)}", flush=True)
+    stdout = open(h.dir / f"{label}.out", "wb")
+    stderr = open(h.dir / f"{label}.err", "wb")
+    process = subprocess.Popen(argv, stdout=stdout, stderr=stderr, preexec_fn=preexec_fn)
+    h.children.append((label, process))
+    return process
+
+
+def stderr_of(h, label):
+    return (h.dir / f"{label}.err").read_text(errors="replace")
+
+
+def gateway_with_recorder(h, *record_flags, preexec_fn=None):
+    """A gateway on a free port and a recorder matched to its writer (and status writer)."""
+    port = free_udp_port()
+    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000")
+    out = h.dir / "run.mcap"
+    rec = recorder(h, "record", out, *record_flags, preexec_fn=preexec_fn)
+    wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "rsg_record's reader to match the gateway's writer")
+    return port, gateway, stats, rec, out
+
+
+def run_sim(h, port, count, rate, *flags):
+    record = h.dir / "sim.record.jsonl"
+    status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", str(rate),
+                           "--count", str(count), "--record", str(record), *flags])
+    check(status == 0, f"rsg_sim exited {status}")
+    return record
+
+
+SELECTIONS = ["--every", "1:q,dq,time", "--every", "3:g0", "--every", "10:all"]
+
+
+def reference_reader(h):
+    """Every frame sent is in the file, decoded by Foxglove's decoder to the values sent; the summary
+    (statistics, chunk indexes, message indexes) is what @mcap/core needs to seek."""
+    port, gateway, stats, rec, out = gateway_with_recorder(h)
+    record = run_sim(h, port, 1500, 1000, *SELECTIONS)
+    wait_for_stats(stats, lambda s: s["frames_published"] >= 1500, "the gateway to publish every frame")
+    wait_for(lambda: out.stat().st_size > 0, "the recording")
+    time.sleep(1.5)  # the last samples and a status sample reach the recorder
+    check(h.stop("record", rec) == 0, f"rsg_record did not exit 0 on SIGTERM: {stderr_of(h, 'record')}")
+    check("dropped 0 (sequence gaps), 0 (lost in DDS)" in stderr_of(h, "record"), stderr_of(h, "record"))
+    seen = node_check(h, out, "--frames", record)
+    check(seen["states"] == 1500 and seen["statuses"] >= 1, f"read {seen}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+def sigkill(h):
+    """A recorder killed with SIGKILL leaves a file that the reference reader reads, record by record,
+    up to its last finished chunk; rsg_replay plays it with a warning."""
+    port, gateway, stats, rec, out = gateway_with_recorder(h)
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "4000",
+                          "--record", str(h.dir / "sim.record.jsonl")])
+    # At 1 kHz a chunk (1 MiB of full frames) is finished about every half second.
+    wait_for(lambda: out.stat().st_size > 400_000, "two finished chunks in the file")
+    rec.send_signal(signal.SIGKILL)
+    rec.wait()
+    check(h.wait("sim", sim, 30) == 0, "rsg_sim failed")
+    seen = node_check(h, out, "--truncated", "--frames", h.dir / "sim.record.jsonl")
+    check(seen["states"] >= 400, f"only {seen['states']} states readable after the kill")
+    status = h.run("replay", [h.binary("rsg_replay"), str(out), "--to", f"127.0.0.1:{free_udp_port()}",
+                              "--speed", "50"])
+    check(status == 0, f"rsg_replay exited {status}: {stderr_of(h, 'replay')}")
+    check(f"sent {seen['states']} samples" in stderr_of(h, "replay") and "ends early" in stderr_of(h, "replay"),
+          f"rsg_replay: {stderr_of(h, 'replay')}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+def write_errors(h):
+    """An unwritable path and a full disk (a file size limit: the kernel refuses writes past it) are
+    clear errors with exit 1; what was recorded stays readable by the reference reader."""
+    status = h.run("unwritable", [h.binary("rsg_record"), "--domain", str(h.domain), "--out",
+                                  str(h.dir / "no" / "such" / "dir.mcap")])
+    check(status == 1, f"rsg_record exited {status} for an unwritable path")
+    check("cannot create" in stderr_of(h, "unwritable") and "No such file or directory" in stderr_of(h, "unwritable"),
+          stderr_of(h, "unwritable"))
+
+    limit = 700_000
+
+    def limit_file_size():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    # Chunks far smaller than the limit, so that whole chunks are on disk before the write that fails
+    # (with the default 1 MiB a single chunk, finished late on a loaded host, can outgrow the limit).
+    port, gateway, stats, rec, out = gateway_with_recorder(h, "--chunk-size", "65536", preexec_fn=limit_file_size)
+    record = run_sim(h, port, 3000, 1000)
+    check(h.wait("record", rec, 20) == 1, f"rsg_record did not exit 1 on a full disk: {stderr_of(h, 'record')}")
+    err = stderr_of(h, "record")
+    check("File too large" in err and "the file was finished" in err, err)
+    check(out.stat().st_size <= limit, "the file outgrew the limit")
+    seen = node_check(h, out, "--frames", record, "--prefix")
+    check(seen["states"] > 100, f"read {seen}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+def replay_roundtrip(h):
+    """record -> replay -> gateway -> rsg_echo --json gives the original stream exactly, and the
+    replayed datagrams are byte for byte the ones the first gateway received; --domain replays the
+    samples over DDS to the same effect."""
+    count = 1200
+    port, gateway, stats, rec, out = gateway_with_recorder(h)
+    tap_port = free_udp_port()
+    tap = UdpRelay(tap_port, forward_to=("127.0.0.1", port))
+    tap.start()
+    try:
+        record = run_sim(h, tap_port, count, 1000, *SELECTIONS)
+        wait_for_stats(stats, lambda s: s["frames_published"] >= count, "the gateway to publish every frame")
+    finally:
+        tap.stop()
+    time.sleep(1.0)
+    check(h.stop("record", rec) == 0, f"rsg_record did not exit 0: {stderr_of(h, 'record')}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+    sent = read_json_lines(record)
+
+    # Raw: replay -> tap -> second gateway -> rsg_echo --json.
+    port2 = free_udp_port()
+    gateway2, stats2 = h.gateway("gateway2", "--listen", f"127.0.0.1:{port2}", "--topic", "replayed",
+                                 "--status-topic", "replayed_status", "--expected-rate", "1000")
+    echo = h.start("echo", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "replayed", "--json",
+                            "--count", str(count), "--timeout", "30"])
+    wait_for_stats(stats2, lambda s: s["state_readers"] >= 1, "rsg_echo to match the second gateway")
+    tap2_port = free_udp_port()
+    tap2 = UdpRelay(tap2_port, forward_to=("127.0.0.1", port2))
+    tap2.start()
+    try:
+        status = h.run("replay", [h.binary("rsg_replay"), str(out), "--to", f"127.0.0.1:{tap2_port}", "--speed", "2"])
+        check(status == 0, f"rsg_replay exited {status}: {stderr_of(h, 'replay')}")
+        check(h.wait("echo", echo, 30) == 0, "rsg_echo did not get every replayed sample")
+    finally:
+        tap2.stop()
+    check(len(tap2.datagrams) == len(tap.datagrams) == count,
+          f"{len(tap.datagrams)} frames recorded, {len(tap2.datagrams)} replayed")
+    for index, (original, replayed) in enumerate(zip(tap.datagrams, tap2.datagrams)):
+        check(original == replayed, f"replayed frame {index} differs from the frame the gateway received")
+    received = read_json_lines(h.output("echo"))
+    check(received == sent, "rsg_echo's stream after the replay differs from what rsg_sim sent")
+    check(h.stop("gateway2", gateway2) == 0, "the second gateway did not exit 0")
+
+    # DDS: replay --domain -> rsg_echo --json.
+    echo2 = h.start("echo2", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "dds_replayed", "--json",
+                              "--count", str(count), "--timeout", "30"])
+    status = h.run("replay_dds", [h.binary("rsg_replay"), str(out), "--domain", str(h.domain), "--topic",
+                                  "dds_replayed", "--wait-for-readers", "1", "--speed", "4"])
+    check(status == 0, f"rsg_replay --domain exited {status}: {stderr_of(h, 'replay_dds')}")
+    check(h.wait("echo2", echo2, 30) == 0, "rsg_echo did not get every sample replayed over DDS")
+    check(read_json_lines(h.output("echo2")) == sent, "the DDS replay differs from what rsg_sim sent")
+
+
+def split_and_view(h):
+    """--split-size starts a new complete file when one is full; --view records only the samples
+    carrying the view's groups (view_poses: group 0, every third and every tenth frame here)."""
+    port, gateway, stats, rec, out = gateway_with_recorder(h, "--split-size", "0.1")
+    viewed = h.dir / "poses.mcap"
+    rec2 = recorder(h, "record_view", viewed, "--view", "view_poses", "--status-topic", "")
+    wait_for_stats(stats, lambda s: s["state_readers"] >= 2, "both recorders to match the gateway's writer")
+    record = run_sim(h, port, 1500, 1000, *SELECTIONS)
+    wait_for_stats(stats, lambda s: s["frames_published"] >= 1500, "the gateway to publish every frame")
+    time.sleep(1.0)
+    check(h.stop("record", rec) == 0 and h.stop("record_view", rec2) == 0, "a recorder did not exit 0")
+    files = sorted(h.dir.glob("run_*.mcap"), key=lambda path: int(path.stem.split("_")[1]))
+    check(len(files) >= 2, f"--split-size 0.1 gave {len(files)} files")
+    states = 0
+    for path in files:
+        check(path.stat().st_size < 600_000, f"{path.name} is {path.stat().st_size} bytes")
+        states += node_check(h, path, "--frames", record, "--skip", states)["states"]
+    check(states == 1500, f"the split files hold {states} states for 1500 frames")
+    seen = node_check(h, viewed, "--frames", record, "--groups", 1)
+    check(seen["statuses"] == 0 and seen["states"] == len([i for i in range(1500) if i % 3 == 0 or i % 10 == 0]),
+          f"view_poses recorded {seen}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+def duration(h):
+    """--duration S stops the recorder by itself with exit 0 and a finished file holding the first
+    frames of the stream."""
+    port, gateway, stats, rec, out = gateway_with_recorder(h, "--duration", "2")
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "20000",
+                          "--record", str(h.dir / "sim.record.jsonl")])
+    check(h.wait("record", rec, 20) == 0, f"rsg_record did not exit 0 after --duration: {stderr_of(h, 'record')}")
+    sim.send_signal(signal.SIGTERM)
+    h.wait("sim", sim)
+    seen = node_check(h, out, "--frames", h.dir / "sim.record.jsonl", "--prefix")
+    check(0 < seen["states"] < 2100, f"a 2 s recording of a 1 kHz stream holds {seen['states']} states")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+def ros2_profile(h):
+    """--profile ros2: the MCAP ros2 profile (header, ros2msg schema rsg_msgs/msg/RobotState with the
+    .msg text, /topic names, offered_qos_profiles as rosbag2 writes them); the CDR bytes are the
+    same, so Foxglove's decoder reads the values sent both with the IDL and with the
+    file's own ros2msg schema (as Foxglove opens a ROS 2 recording)."""
+    port, gateway, stats, rec, out = gateway_with_recorder(h, "--profile", "ros2")
+    record = run_sim(h, port, 600, 1000, *SELECTIONS)
+    wait_for_stats(stats, lambda s: s["frames_published"] >= 600, "the gateway to publish every frame")
+    time.sleep(1.5)
+    check(h.stop("record", rec) == 0, f"rsg_record did not exit 0: {stderr_of(h, 'record')}")
+    msg_dir = ROOT / "ros2" / "rsg_msgs" / "msg"
+    seen = node_check(h, out, "--frames", record, "--profile", "ros2", "--idl", ROOT / "idl" / "RobotState.idl",
+                      "--msg-dir", msg_dir)
+    check(seen["states"] == 600 and seen["statuses"] >= 1, f"read {seen}")
+    # The schemas are those .msg files; rosidl's own parser (Debian's, under /usr/bin/python3) reads them.
+    for name in ("RobotState", "GatewayStatus"):
+        parsed = subprocess.run(["/usr/bin/python3", "-c",
+                                 "import sys; from rosidl_adapter.parser import parse_message_string as p; "
+                                 "print(len(p('rsg_msgs', sys.argv[1], open(sys.argv[2]).read()).fields))",
+                                 name, str(msg_dir / f"{name}.msg")], capture_output=True, text=True)
+        check(parsed.returncode == 0, f"rosidl rejects {name}.msg: {parsed.stderr.strip()}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+def chunk_size_fsync(h):
+    """--chunk-size 65536 finishes a chunk as soon as its records reach 64 KiB (the reference reader
+    finds no larger one, and as many as the recorder reports); --fsync calls fdatasync on the file
+    after every finished chunk and once at the end (strace, Debian's, counts the calls)."""
+    strace = shutil.which("strace")
+    check(strace is not None, "strace is not installed: run `make deps`")
+    chunk = 65536
+    port = free_udp_port()
+    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000")
+    out = h.dir / "run.mcap"
+    trace = h.dir / "fdatasync.trace"
+    # -y names each descriptor's file; --seccomp-bpf stops the recorder for fdatasync calls only.
+    traced = h.start("record", [strace, "-f", "-y", "--seccomp-bpf", "-e", "trace=fdatasync", "-o", str(trace),
+                                h.binary("rsg_record"), "--domain", str(h.domain), "--out", str(out),
+                                "--chunk-size", str(chunk), "--fsync"])
+    wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "rsg_record's reader to match the gateway's writer")
+    record = run_sim(h, port, 2000, 1000)  # every field in every frame: about 2 KB a message
+    wait_for_stats(stats, lambda s: s["frames_published"] >= 2000, "the gateway to publish every frame")
+    time.sleep(1.0)  # the last samples reach the recorder
+    # SIGTERM to rsg_record itself (strace's child), as an operator would; strace then exits with it.
+    children = Path(f"/proc/{traced.pid}/task/{traced.pid}/children").read_text().split()
+    check(len(children) == 1, f"strace has children {children}")
+    os.kill(int(children[0]), signal.SIGTERM)
+    check(h.wait("record", traced, 30) == 0, f"rsg_record did not exit 0 on SIGTERM: {stderr_of(h, 'record')}")
+    err = stderr_of(h, "record")
+    seen = node_check(h, out, "--frames", record)
+    check(seen["states"] == 2000, f"read {seen}")
+    # A chunk ends with the first message that takes it to the limit: at most one message over it.
+    check(seen["largest_chunk"] <= chunk + 4096, f"a chunk of {seen['largest_chunk']} bytes for --chunk-size {chunk}")
+    check(seen["chunks"] >= 2000 * 1500 // (chunk + 4096), f"only {seen['chunks']} chunks of at most {chunk} bytes")
+    check(f" in {seen['chunks']} chunks, " in err, f"the recorder reports other chunks than the file has: {err}")
+    # A call another thread interrupts shows as "fdatasync(3</path> <unfinished ...>", then "<... fdatasync resumed>".
+    lines = trace.read_text().splitlines()
+    syncs = [line for line in lines if "fdatasync(" in line and f"{out}>" in line]
+    failed = [line for line in lines if "fdatasync" in line and "= -1" in line]
+    check(len(syncs) == seen["chunks"] + 1 and not failed,
+          f"{len(syncs)} fdatasync calls on the file for {seen['chunks']} chunks; failed: {failed}")
+    check(f"; {seen['chunks'] + 1} fsyncs in " in err, f"the recorder's summary does not count its fsyncs: {err}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+CASES = {f.__name__: f for f in (reference_reader, sigkill, write_errors, replay_roundtrip, split_and_view, duration,
+                                 ros2_profile, chunk_size_fsync)}
+
+if __name__ == "__main__":
+    sys.exit(main(f"record_{CASE}", CASES[CASE]))

@@ -1,0 +1,101 @@
+#include "rsg/dds/discovery.hpp"
+
+#include <fastrtps/utils/IPLocator.h>
+#include <gtest/gtest.h>
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <sstream>
+
+#include "rsg/dds/profiles.hpp"
+
+namespace rsg {
+namespace {
+
+namespace fdds = eprosima::fastdds::dds;
+using eprosima::fastrtps::rtps::DiscoveryProtocol_t;
+using eprosima::fastrtps::rtps::IPLocator;
+
+DiscoveryOptions servers(std::vector<std::string> values) {
+  DiscoveryOptions options;
+  options.servers = std::move(values);
+  return options;
+}
+
+DiscoveryOptions peers(std::vector<std::string> values) {
+  DiscoveryOptions options;
+  options.peers = std::move(values);
+  return options;
+}
+
+std::string prefix_of(const eprosima::fastdds::rtps::RemoteServerAttributes& server) {
+  std::ostringstream text;
+  text << server.guidPrefix;
+  return text.str();
+}
+
+// `fastdds discovery -i 0` prints "Server GUID prefix: 44.53.00.5f.45.50.52.4f.53.49.4d.41"; the
+// third byte is the id.
+TEST(Discovery, ServersBecomeClientOfTheIdsFastddsDiscoveryUses) {
+  fdds::DomainParticipantQos qos;
+  apply_discovery(servers({"198.18.0.2:11811", "198.18.0.3:11812", "7@198.18.0.4:11813"}), 0, qos);
+  const auto& config = qos.wire_protocol().builtin.discovery_config;
+  EXPECT_EQ(config.discoveryProtocol, DiscoveryProtocol_t::CLIENT);
+  ASSERT_EQ(config.m_DiscoveryServers.size(), 3u);
+  const auto& first = config.m_DiscoveryServers.front();
+  EXPECT_EQ(prefix_of(first), "44.53.00.5f.45.50.52.4f.53.49.4d.41");
+  ASSERT_EQ(first.metatrafficUnicastLocatorList.size(), 1u);
+  const auto& locator = *first.metatrafficUnicastLocatorList.begin();
+  EXPECT_EQ(IPLocator::ip_to_string(locator), "198.18.0.2");
+  EXPECT_EQ(locator.port, 11811u);
+  auto server = config.m_DiscoveryServers.begin();
+  EXPECT_EQ(prefix_of(*++server), "44.53.01.5f.45.50.52.4f.53.49.4d.41");
+  EXPECT_EQ(prefix_of(*++server), "44.53.07.5f.45.50.52.4f.53.49.4d.41");
+}
+
+TEST(Discovery, TheXmlExampleIsTheSameClient) {
+  load_profiles(default_profiles_dir());
+  fdds::DomainParticipantQos from_xml;
+  ASSERT_EQ(fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
+                "rsg_discovery_client", from_xml),
+            ReturnCode_t::RETCODE_OK);
+  fdds::DomainParticipantQos from_flag;
+  apply_discovery(servers({"127.0.0.1:11811"}), 0, from_flag);
+  EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.discoveryProtocol, DiscoveryProtocol_t::CLIENT);
+  EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.m_DiscoveryServers,
+            from_flag.wire_protocol().builtin.discovery_config.m_DiscoveryServers);
+  // Both run the discovery cycle every 50 ms, not Fast DDS's 450 (docs/scaling.md).
+  const eprosima::fastrtps::Duration_t fifty_ms(0, 50'000'000);
+  EXPECT_EQ(from_flag.wire_protocol().builtin.discovery_config.discoveryServer_client_syncperiod, fifty_ms);
+  EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.discoveryServer_client_syncperiod, fifty_ms);
+}
+
+TEST(Discovery, APeerWithoutPortCoversEveryGatewayParticipantId) {
+  fdds::DomainParticipantQos qos;
+  apply_discovery(peers({"198.18.0.2", "198.18.0.3:7412"}), 3, qos);
+  const auto& peers = qos.wire_protocol().builtin.initialPeersList;
+  ASSERT_EQ(peers.size(), 61u);
+  // Metatraffic unicast port of participant id i on domain 3: 7400 + 250 * 3 + 10 + 2 * i.
+  EXPECT_EQ(peers.begin()->port, 8160u);
+  EXPECT_EQ((peers.begin() + 59)->port, 8160u + 2 * 59);
+  EXPECT_EQ(IPLocator::ip_to_string(*(peers.begin() + 60)), "198.18.0.3");
+  EXPECT_EQ((peers.begin() + 60)->port, 7412u);
+  EXPECT_EQ(qos.wire_protocol().builtin.discovery_config.discoveryProtocol, DiscoveryProtocol_t::SIMPLE);
+}
+
+TEST(Discovery, BadValuesNameThemselves) {
+  EXPECT_NE(check_discovery_server("198.18.0.2").find("HOST:PORT"), std::string::npos);
+  EXPECT_NE(check_discovery_server("256@h:1").find("0..255"), std::string::npos);
+  EXPECT_NE(check_peer("h:70000").find("1..65535"), std::string::npos);
+  EXPECT_EQ(check_peer("h"), "");
+  fdds::DomainParticipantQos qos;
+  try {
+    // Syntax is checked before any name is resolved (no DNS query from a unit test).
+    apply_discovery(servers({"gw.plant"}), 0, qos);
+    FAIL() << "a server without a port was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("gw.plant"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace rsg

@@ -1,0 +1,245 @@
+"""rsg_view with real clients: rsg_sim -> rsg_gateway -> rsg_view, then npm's @foxglove/ws-protocol
+client and Foxglove's CDR decoder (check_view.mjs), or Debian's headless Chromium on the page
+(check_page.mjs). Each case is one ctest test (view.<case>), in its own DDS domain and ports.
+
+    test_view.py --bin build/bin --case foxglove_legacy
+"""
+
+import json
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "integration"))
+from harness import check, free_udp_port, main, read_json_lines, wait_for, wait_for_stats  # noqa: E402
+
+CASE = sys.argv[sys.argv.index("--case") + 1]
+del sys.argv[sys.argv.index("--case"):sys.argv.index("--case") + 2]
+SCREENSHOT = None
+if "--screenshot" in sys.argv:
+    SCREENSHOT = sys.argv[sys.argv.index("--screenshot") + 1]
+    del sys.argv[sys.argv.index("--screenshot"):sys.argv.index("--screenshot") + 2]
+SELECTIONS = ["--every", "1:q,dq,time", "--every", "3:g0", "--every", "10:all"]
+
+
+def free_tcp_port():
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def node():
+    """Node and the packages of tests/view; fails the test (never skips) when they are missing."""
+    path = shutil.which("node")
+    check(path is not None, "node is not installed: run `make deps`")
+    check((HERE / "node_modules" / "@foxglove" / "ws-protocol").is_dir(),
+          "tests/view/node_modules is missing: run `make deps` (npm ci --prefix tests/view)")
+    return path
+
+
+def flatten(value, prefix=""):
+    """{"invalid": {"bad_crc": 1}} -> {"invalid_bad_crc": 1}, as rsg_msgs/msg/GatewayStatus spells it."""
+    out = {}
+    for name, item in value.items():
+        if isinstance(item, dict):
+            out.update(flatten(item, f"{prefix}{name}_"))
+        else:
+            out[f"{prefix}{name}"] = item
+    return out
+
+
+def start_view(h, *flags):
+    """A gateway and an rsg_view matched to its writer; returns (udp port, gateway, stats, view, ws port)."""
+    port = free_udp_port()
+    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000")
+    ws_port = free_tcp_port()
+    view = h.start("view", [h.binary("rsg_view"), "--domain", str(h.domain), "--listen", f"127.0.0.1:{ws_port}",
+                            *flags])
+    wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "rsg_view's reader to match the gateway's writer")
+    wait_for(lambda: "serving" in (h.dir / "view.err").read_text(), "rsg_view to listen")
+    return port, gateway, stats, view, ws_port
+
+
+def foxglove_client(h, subprotocol, *flags, count=600, rate=500, view_flags=(), before_sim=None):
+    """Every frame sent arrives through rsg_view, decoded by Foxglove's decoder to the values sent."""
+    port, gateway, stats, view, ws_port = start_view(h, *view_flags)
+    if before_sim:
+        before_sim(ws_port)
+    record = h.dir / "sim.record.jsonl"
+    # The ros2msg channels exist when the build embedded rsg_msgs' .msg files (it does from this tree).
+    msg_dir = ROOT / "ros2" / "rsg_msgs" / "msg"
+    ros2 = ["--ros2", str(msg_dir)] if (msg_dir / "GatewayStatus.msg").exists() else []
+    client = h.start("client", [node(), str(HERE / "check_view.mjs"), f"ws://127.0.0.1:{ws_port}", "--subprotocol",
+                                subprotocol, "--count", str(count), "--frames", str(record), *ros2, *flags])
+    wait_for(lambda: "ready" in h.output("client").read_text() or client.poll() is not None, "the client to subscribe")
+    check(client.poll() is None, f"the client failed: {(h.dir / 'client.err').read_text()}")
+    status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", str(rate), "--count", str(count),
+                           "--record", str(record), *SELECTIONS])
+    check(status == 0, f"rsg_sim exited {status}")
+    check(h.wait("client", client, 60) == 0, f"check_view failed: {(h.dir / 'client.err').read_text()}")
+    result = json.loads(h.output("client").read_text().splitlines()[-1])
+    print(f"[{h.name}] client: {result}", flush=True)
+    expected = "foxglove.sdk.v1" if subprotocol == "sdk" else "foxglove.websocket.v1"
+    check(result["subprotocol"] == expected and result["states"] == count, f"client saw {result}")
+    if ros2:
+        # The last GatewayStatus, decoded from the ros2msg channel, holds the gateway's own counters
+        # (its --stats-file; the nested invalid counts spelled out as in the .msg). Rate and link
+        # state change with time, so they are left out.
+        gateway_stats = flatten(wait_for_stats(stats, lambda s: s["frames_published"] >= count, "the gateway's stats"))
+        status = result["last_status"]
+        check(set(status) == set(gateway_stats), f"status members {sorted(status)} != stats {sorted(gateway_stats)}")
+        for name, value in gateway_stats.items():
+            check(name in ("rate_hz", "link_up") or status[name] == value,
+                  f"GatewayStatus over ros2msg: {name} = {status[name]}, the gateway says {value}")
+    check(h.stop("view", view) == 0, "rsg_view did not exit 0 on SIGTERM")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+    return result
+
+
+def foxglove_legacy(h):
+    """npm's @foxglove/ws-protocol client (foxglove.websocket.v1); malformed requests get error
+    statuses and the connection keeps working."""
+    foxglove_client(h, "legacy", "--malformed")
+    err = (h.dir / "view.err").read_text()
+    check("malformed message: not JSON" in err, f"rsg_view did not log the malformed message: {err}")
+
+
+def foxglove_sdk(h):
+    """A client offering foxglove.sdk.v1 (the current Foxglove app) gets that subprotocol and the same data."""
+    foxglove_client(h, "sdk")
+
+
+def slow_client(h):
+    """A client that stops reading loses its own oldest messages (the default --queue-depth, 256), is told
+    how many in a warning status, and rsg_view logs it; a client reading at the same time gets every
+    sample, and rsg_view's DDS reader misses none."""
+    stalled = {}
+
+    def start_stalled(ws_port):
+        stalled["process"] = h.start("stalled", [node(), str(HERE / "stall_client.mjs"), f"ws://127.0.0.1:{ws_port}",
+                                                 "4000"])
+        wait_for(lambda: "ready" in h.output("stalled").read_text(), "the stalled client to subscribe")
+
+    foxglove_client(h, "legacy", count=5000, rate=1000, before_sim=start_stalled)
+    check(h.wait("stalled", stalled["process"], 60) == 0,
+          f"the stalled client got no drop report: {(h.dir / 'stalled.err').read_text()}")
+    report = json.loads(h.output("stalled").read_text().splitlines()[-1])
+    print(f"[{h.name}] stalled client: {report}", flush=True)
+    check(report["dropped"] > 0, f"nothing dropped for the stalled client: {report}")
+    err = (h.dir / "view.err").read_text()
+    check("messages: this connection reads slower than the data arrives" in err, f"rsg_view did not log the drops: {err}")
+    check("received 5000 states" in err, f"rsg_view's reader missed samples: {err}")
+
+
+def fair_share(h):
+    """Big channels do not starve small ones: of two clients subscribed to every channel, one reads
+    slowly (its socket left unread for 3 s at a time), so rsg_view drops RobotState messages for it.
+    Counted against the other client, which reads everything: the slow one still gets every
+    GatewayStatus (all three flavours), and the end-effector transform (a tenth of the frames carry
+    O_T_EE) loses no larger a share than RobotState does. The drop report it gets and rsg_view's
+    per-channel counters name the RobotState channels only."""
+    stop = h.dir / "stop"
+    clients = {}
+
+    def start_clients(ws_port):
+        for label, flags in (("reference", []), ("slow", ["--pause-ms", "3000", "--read-ms", "50"])):
+            clients[label] = h.start(label, [node(), str(HERE / "fair_client.mjs"), f"ws://127.0.0.1:{ws_port}",
+                                             "--stop", str(stop), *flags])
+        for label in clients:
+            wait_for(lambda: "ready" in h.output(label).read_text(), f"the {label} client to subscribe")
+
+    port, gateway, stats, view, ws_port = start_view(h)
+    start_clients(ws_port)
+    status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "8000",
+                           "--every", "1:q,dq,tau_J,time", "--every", "10:all"], timeout_s=60)
+    check(status == 0, f"rsg_sim exited {status}")
+    wait_for_stats(stats, lambda s: s["frames_published"] >= 8000, "the gateway to publish every frame")
+    stop.touch()
+    results = {}
+    for label, process in clients.items():
+        check(h.wait(label, process, 60) == 0, f"the {label} client failed: {(h.dir / f'{label}.err').read_text()}")
+        results[label] = json.loads(h.output(label).read_text().splitlines()[-1])
+        print(f"[{h.name}] {label} client: {results[label]}", flush=True)
+    check(h.stop("view", view) == 0, "rsg_view did not exit 0 on SIGTERM")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+    reference, slow = results["reference"]["received"], results["slow"]["received"]
+    share = {name: slow[name] / reference[name] for name in reference if reference[name] > 0}
+    print(f"[{h.name}] share the slow client got: {share}", flush=True)
+    states = [name for name in reference if "RobotState" in name]
+    statuses = [name for name in reference if "GatewayStatus" in name]
+    transform = next(name for name in reference if "FrameTransform" in name)
+    # On a loaded machine even the reference may fall behind for a moment and lose a few.
+    check(len(states) >= 1 and all(reference[name] >= 7600 for name in states),
+          f"the reference client missed RobotState messages: {results['reference']}")
+    check(all(share[name] < 0.9 for name in states), f"the slow client was not slow enough to lose RobotState: {share}")
+    check(len(statuses) >= 2 and all(reference[name] >= 5 and slow[name] >= reference[name] - 1 for name in statuses),
+          f"the slow client lost GatewayStatus messages: {slow} vs {reference}")
+    check(reference[transform] >= 700 and share[transform] >= min(share[name] for name in states),
+          f"the transform lost a larger share than RobotState: {share}")
+    report = results["slow"]["drop_report"] or ""
+    check(all(f"{name}: " in report for name in states) and "GatewayStatus" not in report,
+          f"the slow client's drop report: {report!r}")
+    # rsg_view's own per-channel counters, in its log at exit.
+    counters = {f"{m[1]} ({m[2]})": int(m[3]) for m in
+                re.finditer(r"channel \d+ (\S+) \((\S+), \w+\): published \d+, dropped (\d+)", (h.dir / "view.err").read_text())}
+    check(all(counters[name] > 0 for name in states) and all(counters[name] == 0 for name in statuses),
+          f"rsg_view's drop counters: {counters}")
+
+
+def limits(h):
+    """--max-clients refuses the client too many; a burst past 100 requests a second gets one error
+    status; a client message over 64 KiB closes that connection (and is logged); HTTP refuses unknown
+    paths, other methods than GET, and WebSocket upgrades without a Foxglove subprotocol."""
+    port, gateway, stats, view, ws_port = start_view(h, "--max-clients", "1")
+    status = h.run("limits", [node(), str(HERE / "limits_client.mjs"), f"127.0.0.1:{ws_port}"])
+    check(status == 0, f"limits_client failed: {(h.dir / 'limits.err').read_text()}")
+    result = json.loads(h.output("limits").read_text().splitlines()[-1])
+    print(f"[{h.name}] {result}", flush=True)
+    check(result["unknown_path"] == 404 and result["post"] == 405 and result["no_subprotocol"] == 400, f"HTTP: {result}")
+    check(result["second_client"]["code"] == 1013 and result["second_client"]["reason"] == "too many clients",
+          f"the second client was not refused: {result}")
+    check(result["rate_errors"] == 1, f"rate limit: {result}")
+    check(result["big_message"]["code"] != 1000, f"a 70 KiB message did not close the connection: {result}")
+    err = (h.dir / "view.err").read_text()
+    check("sent a message over 65536 bytes: closed" in err and "already 1 clients" in err, f"rsg_view's log: {err}")
+    check(h.stop("view", view) == 0, "rsg_view did not exit 0 on SIGTERM")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+def page(h):
+    """Debian's headless Chromium loads the page while rsg_sim runs: the page shows live samples, the
+    last q it shows is one rsg_sim sent, Chart.js plots them, and the gateway panel says the link is up."""
+    chromium = shutil.which("chromium")
+    check(chromium is not None, "chromium is not installed: run `make deps`")
+    screenshot = Path(SCREENSHOT) if SCREENSHOT else h.dir / "rsg_view.png"
+    port, gateway, stats, view, ws_port = start_view(h)
+    record = h.dir / "sim.record.jsonl"
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "60000",
+                          "--record", str(record)])
+    devtools = free_tcp_port()
+    h.start("chromium", [chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+                         f"--user-data-dir={h.dir / 'chromium'}", f"--remote-debugging-port={devtools}",
+                         "about:blank"])
+    status = h.run("page", [node(), str(HERE / "check_page.mjs"), str(devtools), f"http://127.0.0.1:{ws_port}/",
+                            str(screenshot)], timeout_s=60)
+    check(status == 0, f"check_page failed: {(h.dir / 'page.err').read_text()}")
+    shown = json.loads(h.output("page").read_text().splitlines()[-1])
+    print(f"[{h.name}] the page showed {shown}; screenshot {screenshot}", flush=True)
+    check(h.stop("sim", sim) == 0, "rsg_sim did not exit 0 on SIGTERM")
+    sent = {", ".join(f"{v:.4f}" for v in frame["fields"]["q"]) for frame in read_json_lines(record)
+            if "q" in frame["fields"]}
+    check(shown["last_q"] in sent, f"the page shows q = {shown['last_q']}, which rsg_sim never sent")
+    check(shown["chart_js"] and shown["q_points"] >= 50, f"Chart.js did not plot: {shown}")
+    check(h.stop("view", view) == 0, "rsg_view did not exit 0 on SIGTERM")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+if __name__ == "__main__":
+    sys.exit(main(f"view.{CASE}", globals()[CASE]))
