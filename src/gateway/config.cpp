@@ -99,12 +99,14 @@ const std::array kKeys = {
         [](const GatewayConfig& c) { return c.receive_buffer >= 0 ? "" : std::string("must be >= 0"); }},
     ConfigKey{
         "rate-topic",
-        "Also publish the state on NAME at most HZ times a second, e.g. robot_state_50hz:50 (repeatable; "
-        "paced by the robot's time when frames carry it, else by arrival)",
+        "Also publish the state on NAME at RATE, given as NAME:RATE with RATE as for --joint-states: HZ (at "
+        "most HZ times a second, paced by the robot's time when frames carry it, else by arrival) or every:N "
+        "(every Nth frame), e.g. robot_state_50hz:50 or robot_state_tenth:every:10 (repeatable)",
         &GatewayConfig::rate_topics,
         [](const GatewayConfig& c) {
           for (const auto& value : c.rate_topics)
-            if (!parse_rate_topic(value)) return "'" + value + "' is not NAME:HZ with HZ in (0, 10000]";
+            if (!parse_rate_topic(value))
+              return "'" + value + "' is not NAME:HZ with HZ in (0, 10000] nor NAME:every:N with N >= 1";
           return std::string();
         }},
     ConfigKey{"egress-topic", "Send the samples of this topic as raw frames to --send-to",
@@ -381,15 +383,14 @@ std::optional<std::string> check_config(const GatewayConfig& config) {
 }
 
 std::optional<RateTopic> parse_rate_topic(const std::string& value) {
-  const std::size_t colon = value.rfind(':');
-  if (colon == std::string::npos || colon == 0) return std::nullopt;
-  RateTopic rate{value.substr(0, colon), 0};
-  const std::string_view hz = std::string_view(value).substr(colon + 1);
-  const auto [end, status] = std::from_chars(hz.data(), hz.data() + hz.size(), rate.hz);
-  if (hz.empty() || status != std::errc() || end != hz.data() + hz.size() ||
-      !(rate.hz > 0 && rate.hz <= 10000))
-    return std::nullopt;
-  return rate;
+  // The rate follows the first colon after which the rest reads as one, so "a:every:5" is `a` every
+  // 5th frame (not `a:every` at 5 Hz) while a NAME may still hold colons of its own.
+  if (value.starts_with(':')) return std::nullopt;  // no NAME
+  for (std::size_t colon = value.find(':'); colon != std::string::npos; colon = value.find(':', colon + 1)) {
+    if (const auto decimation = parse_decimation(value.substr(colon + 1)))
+      return RateTopic{value.substr(0, colon), *decimation};
+  }
+  return std::nullopt;
 }
 
 std::optional<Decimation> parse_decimation(const std::string& value) {

@@ -133,10 +133,10 @@ ConfigResult parse_gateway_config(std::string_view yaml_text, const GatewayConfi
 /// Returns what is wrong, or nothing.
 std::optional<std::string> check_config(const GatewayConfig& config);
 
-/// One `rate-topic` value "NAME:HZ" split, or nothing when it is not of that form.
+/// One `rate-topic` value "NAME:HZ" or "NAME:every:N" split, or nothing when it is neither.
 struct RateTopic {
   std::string name;
-  double hz = 0;
+  Decimation rate;
 };
 std::optional<RateTopic> parse_rate_topic(const std::string& value);
 

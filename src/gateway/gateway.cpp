@@ -139,8 +139,7 @@ GatewaySetup prepare(const GatewayConfig& config) {
     ingress.type_name = state_type_name(config);
     for (const auto& value : config.rate_topics) {
       const RateTopic rate = *parse_rate_topic(value);
-      ingress.rate_topics.push_back(
-          {dds_topic(config, rate.name), std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / rate.hz))});
+      ingress.rate_topics.push_back({dds_topic(config, rate.name), rate.rate});
     }
     ingress.standard_topics = standard_topics_of(config);
     ingress.partitions = partitions_of(config);

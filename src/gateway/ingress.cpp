@@ -93,7 +93,7 @@ Ingress::Ingress(Participant& participant, Options options)
       participant_.get()->delete_publisher(publisher_);
       throw std::runtime_error("cannot create the writer of --rate-topic '" + rate.topic + "'");
     }
-    rate_writers_.push_back({rate_writer, Decimator({0, rate.period})});
+    rate_writers_.push_back({rate_writer, Decimator(rate.rate)});
   }
   if (options_.standard_topics && options_.standard_topics->any()) {
     try {

@@ -48,7 +48,7 @@ class Ingress {
     /// Downsampled copies: each topic gets the frames that fall due at its period (same type).
     struct RateTopic {
       std::string topic;
-      std::chrono::nanoseconds period{};
+      Decimation rate;
     };
     std::vector<RateTopic> rate_topics;
     /// sensor_msgs/JointState, TF and the external wrench, each at its own rate, written by a

@@ -159,14 +159,24 @@ TEST(GatewayConfig, Ros2ModeAndNamespace) {
   EXPECT_FALSE(check_config(egress).has_value());
 }
 
-TEST(GatewayConfig, RateTopicsAreNameColonHz) {
-  const GatewayConfig config = parse_ok("rate-topic: [slow:50, ui:2.5]\n");
-  ASSERT_EQ(config.rate_topics.size(), 2u);
+TEST(GatewayConfig, RateTopicsAreNameColonHzOrEveryN) {
+  const GatewayConfig config = parse_ok("rate-topic: [slow:50, ui:2.5, tenth:every:10, ns:a:every:3]\n");
+  ASSERT_EQ(config.rate_topics.size(), 4u);
   const auto ui = parse_rate_topic(config.rate_topics[1]);
   ASSERT_TRUE(ui);
   EXPECT_EQ(ui->name, "ui");
-  EXPECT_EQ(ui->hz, 2.5);
-  for (const char* bad : {"slow", "slow:", ":50", "slow:0", "slow:-1", "slow:50hz", "slow:20000"})
+  EXPECT_EQ(ui->rate.every, 0u);
+  EXPECT_EQ(ui->rate.period, std::chrono::nanoseconds(400'000'000));
+  const auto tenth = parse_rate_topic(config.rate_topics[2]);
+  ASSERT_TRUE(tenth);
+  EXPECT_EQ(tenth->name, "tenth");
+  EXPECT_EQ(tenth->rate.every, 10u);
+  const auto colons = parse_rate_topic(config.rate_topics[3]);
+  ASSERT_TRUE(colons);
+  EXPECT_EQ(colons->name, "ns:a");
+  EXPECT_EQ(colons->rate.every, 3u);
+  for (const char* bad : {"slow", "slow:", ":50", "slow:0", "slow:-1", "slow:50hz", "slow:20000",
+                          "slow:every:", "slow:every:0", ":every:5", "every:5:"})
     EXPECT_FALSE(parse_rate_topic(bad)) << bad;
   EXPECT_NE(parse_error("rate-topic: slow\n").message.find("NAME:HZ"), std::string::npos);
 }

@@ -1,5 +1,5 @@
 """--rate-topic NAME:HZ: a second RobotState topic carrying the frames that fall due at HZ, paced by
-the robot's `time`, while the full-rate topic still gets every frame. Counts, not timings: rsg_sim's
+the robot's `time`, while the full-rate topic still gets every frame; NAME:every:N: every Nth frame. Counts, not timings: rsg_sim's
 `time` advances 2 ms per frame at 500 Hz, so 500 frames span 1 s of robot time whatever the load."""
 
 import sys
@@ -14,7 +14,8 @@ RATE = "500"
 def body(h):
     port = free_udp_port()
     gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", RATE,
-                               "--rate-topic", "robot_state_50hz:50", "--rate-topic", "robot_state_10hz:10")
+                               "--rate-topic", "robot_state_50hz:50", "--rate-topic", "robot_state_10hz:10",
+                               "--rate-topic", "robot_state_tenth:every:10")
     wait_for_stats(stats, lambda s: True, "the gateway to start")
     # The rate readers end on their idle timeout; it must outlast their discovery on a loaded host.
     echo = lambda label, topic, count, idle: h.start(label, [  # noqa: E731
@@ -23,12 +24,13 @@ def body(h):
     full = echo("full", "robot_state", 10**9, 60)  # read to the end, then killed
     slow = echo("slow", "robot_state_50hz", COUNT, 8)
     slower = echo("slower", "robot_state_10hz", COUNT, 8)
+    tenth = echo("tenth", "robot_state_tenth", COUNT, 8)
     wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "the full-rate reader to match")
     # The rate readers are volatile: a warm-up stream (q and time only) runs until each got a sample,
     # so that the measured stream (every field) starts with every reader matched.
     warm_up = h.start("warm_up", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", RATE, "--count",
                                   str(WARM_UP_MAX), "--fields", "q,time"])
-    for label in ("slow", "slower"):
+    for label in ("slow", "slower", "tenth"):
         wait_for(lambda: h.output(label).stat().st_size > 0, f"{label} to get a warm-up sample")
     h.stop("warm_up", warm_up)
     record = h.dir / "sim.record.jsonl"
@@ -40,6 +42,7 @@ def body(h):
     wait_for(lambda: last() == sent[-1], "the full-rate topic to get the last frame")
     h.wait("slow", slow, 45)
     h.wait("slower", slower, 45)
+    h.wait("tenth", tenth, 45)
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
 
     check(read_json_lines(h.output("full"))[-COUNT:] == sent, "the full-rate topic differs from what the sim sent")
@@ -52,6 +55,11 @@ def body(h):
         check(all(sample in sent for sample in got), f"{label}: a sample that was not sent")
         gaps = [b - a for a, b in zip(times, times[1:])]
         check(all(gap >= 1000 / hz - 2 for gap in gaps), f"{label}: samples closer than 1/{hz} s: {gaps}")
+    # every:10 counts frames, not time: exactly every 10th frame of the measured stream, in order.
+    got = [sample for sample in read_json_lines(h.output("tenth")) if sample["group_select"] == 63]
+    check(len(got) == COUNT // 10, f"tenth: {len(got)} samples of {COUNT} frames, expected {COUNT // 10}")
+    first = sent.index(got[0])
+    check(first < 10 and got == sent[first::10], "tenth: not every 10th frame sent")
 
 
 if __name__ == "__main__":

@@ -193,20 +193,26 @@ int run(const Options& options, rsg::record::Profile profile) {
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
   int exit_code = kExitOk;
+  const auto write_what_was_received = [&] {
+    while (readers.state().take_next_sample(&state, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      loss.add(info);
+      recording.write_state(state, info);
+    }
+    while (readers.status() != nullptr &&
+           readers.status()->take_next_sample(&status, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) recording.write_status(status, info);
+  };
   try {
     while (!readers.stop_requested() &&
            (options.duration_s == 0 || std::chrono::steady_clock::now() - start < duration)) {
       readers.wait(kBatchPeriod);
-      while (readers.state().take_next_sample(&state, &info) == ReturnCode_t::RETCODE_OK) {
-        if (!info.valid_data) continue;
-        loss.add(info);
-        recording.write_state(state, info);
-      }
-      while (readers.status() != nullptr &&
-             readers.status()->take_next_sample(&status, &info) == ReturnCode_t::RETCODE_OK)
-        if (info.valid_data) recording.write_status(status, info);
+      write_what_was_received();
       recording.tick();
     }
+    // A slow disk (--fsync, a busy host) can leave the recorder seconds behind DDS: what the reader
+    // history already holds at SIGTERM was received and belongs in the file.
+    write_what_was_received();
     recording.close();
   } catch (const rsg::mcap::WriteError& error) {
     std::cerr << "rsg_record: " << error.what() << "\n";
