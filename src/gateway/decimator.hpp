@@ -8,7 +8,6 @@
 
 #include <chrono>
 #include <cstdint>
-#include <optional>
 
 namespace rsg::gateway {
 
@@ -33,10 +32,11 @@ class Decimator {
     }
     const auto period = decimation_.period;
     // A restarted robot (time going back) or a stall restarts the schedule instead of catching up.
-    if (due_ && t >= *due_ && t < *due_ + period) {
-      due_ = *due_ + period;
-    } else if (!due_ || t >= *due_ || t + period < *due_) {
+    if (scheduled_ && t >= due_ && t < due_ + period) {
+      due_ += period;
+    } else if (!scheduled_ || t >= due_ || t + period < due_) {
       due_ = t + period;
+      scheduled_ = true;
     } else {
       return false;  // not due yet
     }
@@ -46,7 +46,9 @@ class Decimator {
  private:
   Decimation decimation_;
   std::uint32_t count_ = 0;
-  std::optional<std::chrono::nanoseconds> due_;  // unset: the next frame is due
+  // A flag rather than std::optional: GCC 12 warns (maybe-uninitialized) on the inlined optional.
+  bool scheduled_ = false;  // false: the next frame is due
+  std::chrono::nanoseconds due_{};
 };
 
 }  // namespace rsg::gateway

@@ -33,6 +33,7 @@
 #include "pcap_file.hpp"
 #include "random_state.hpp"
 #include "rsg/dds/profiles.hpp"
+#include "rsg/dds/ros2.hpp"
 #include "rsg/wire/frame.hpp"
 
 namespace rsg::gateway {
@@ -106,7 +107,9 @@ class IngressAllocation : public ::testing::Test {
     options.receive_buffer = 4 << 20;
     std::string error;
     EXPECT_TRUE(options.sources.allow("127.0.0.0/8", error)) << error;  // a filter that is consulted
-    options.topic = "ingress_alloc";
+    options.topic = topic_;
+    options.type_name = type_name_;
+    options.rate_topics = rate_topics_;
     options.writer_profile = writer_profile;
     options.nominal_period = std::chrono::milliseconds(1);
     options.restart_threshold_ms = 100;
@@ -137,7 +140,7 @@ class IngressAllocation : public ::testing::Test {
     reader_qos.history().depth = 100;
     reader_qos.data_sharing().off();  // a transport, not shared memory, carries the samples
     fdds::DataReader* reader = subscribing_.subscriber()->create_datareader(
-        subscribing_.robot_state_topic("ingress_alloc"), reader_qos);
+        subscribing_.robot_state_topic(topic_, type_name_), reader_qos);
     EXPECT_NE(reader, nullptr);
     const auto stats = [&] {
       GatewayStats now;
@@ -206,6 +209,9 @@ class IngressAllocation : public ::testing::Test {
   std::size_t callbacks_ = 0;
   double last_q0_ = 0;
   std::optional<Ros2StandardTopics::Options> standard_topics_;
+  std::string topic_ = "ingress_alloc";
+  std::string type_name_;  // empty: rsg's own
+  std::vector<Ingress::Options::RateTopic> rate_topics_;
   const int domain_ = static_cast<int>(::getpid() % 200 + 10);
   Participant publishing_{domain_, "rsg_hot_path_udp"};
   Participant subscribing_{domain_, "rsg_hot_path_udp"};
@@ -288,6 +294,19 @@ TEST_F(IngressAllocation, WithTheRos2StandardTopicsOnNothingAllocates) {
                        static_cast<unsigned long>(topics->written()[2]),
                        static_cast<unsigned long>(topics->dropped()));
          });
+  expect_none_by_rsg();
+  EXPECT_EQ(allocations_.by_fast_dds(), 0U) << "Fast DDS allocated on the ingress thread";
+}
+
+// --ros2 names the topic rt/<ns>/robot_state and the type as ROS 2 does; the sample, its loan and
+// the ingress loop are the same, so ROS 2 mode allocates nothing either, nor do rate topics (one
+// by robot time, one every 10th frame), whose writes copy into their writers' preallocated history.
+TEST_F(IngressAllocation, InRos2ModeWithRateTopicsNothingAllocates) {
+  topic_ = ros2_topic_name("/robot1", "robot_state");
+  type_name_ = std::string(kRos2RobotStateType);
+  rate_topics_ = {{ros2_topic_name("/robot1", "robot_state_100hz"), {0, 10ms}},
+                  {ros2_topic_name("/robot1", "robot_state_tenth"), {10, {}}}};
+  stream("ingress_alloc_best_effort", fdds::BEST_EFFORT_RELIABILITY_QOS);
   expect_none_by_rsg();
   EXPECT_EQ(allocations_.by_fast_dds(), 0U) << "Fast DDS allocated on the ingress thread";
 }
