@@ -44,6 +44,15 @@ def wait_for(predicate, what, timeout_s=DEFAULT_WAIT_S, interval_s=0.05):
         time.sleep(interval_s)
 
 
+def wait_reader_matched(h, label, tool, writers=1):
+    """Waits until the tool started as `label` (rsg_echo, rsg_record) says on stderr that its reader
+    matched `writers` writer(s). A gateway's `state_readers` is the writer's side of discovery; the
+    reader may learn of the writer later, and a volatile reader misses what is sent in between."""
+    line = f"{tool}: matched {writers} writer{'' if writers == 1 else 's'} of "
+    err = h.dir / f"{label}.err"
+    wait_for(lambda: err.exists() and line in err.read_text(errors="replace"), f"{label}'s reader to match")
+
+
 def free_udp_port():
     """A port no one is bound to right now (the kernel's pick for port 0)."""
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:

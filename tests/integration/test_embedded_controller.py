@@ -6,7 +6,7 @@ import re
 import signal
 import sys
 
-from harness import check, main, read_json_lines, wait_for, wait_for_stats, free_udp_port
+from harness import check, main, read_json_lines, wait_for, wait_for_stats, wait_reader_matched, free_udp_port
 
 COUNT = 500
 RATE = "500"
@@ -23,6 +23,7 @@ def body(h):
     echo = h.start("echo", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "robot_state",
                             "--json", "--count", str(COUNT), "--timeout", "45"])
     wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "rsg_echo's reader to match the embedded writer")
+    wait_reader_matched(h, "echo", "rsg_echo")
 
     record = h.dir / "sim.record.jsonl"
     status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", RATE, "--count", str(COUNT),

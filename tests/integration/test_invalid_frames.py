@@ -3,7 +3,7 @@ status topic) equal what the sim says it sent, category by category."""
 
 import sys
 
-from harness import (check, main, read_json, read_json_lines, wait_for, wait_for_stats, free_udp_port)
+from harness import (check, main, read_json, read_json_lines, wait_for, wait_for_stats, wait_reader_matched, free_udp_port)
 
 # Frames 3, 7, 11, ... 699 are corrupted: 175 invalid, cycling through the seven categories. The
 # last frame is valid: a gap at the very end is invisible to packet numbers.
@@ -22,6 +22,7 @@ def body(h):
     echo = h.start("echo", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "robot_state",
                             "--json", "--count", str(VALID), "--timeout", "45"])
     wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "rsg_echo's reader to match the gateway's writer")
+    wait_reader_matched(h, "echo", "rsg_echo")
 
     record, report_path = h.dir / "sim.record.jsonl", h.dir / "sim.report.json"
     status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", RATE, "--count", str(COUNT),

@@ -4,7 +4,7 @@ the robot's `time`, while the full-rate topic still gets every frame; NAME:every
 
 import sys
 
-from harness import check, free_udp_port, main, read_json_lines, wait_for, wait_for_stats
+from harness import check, free_udp_port, main, read_json_lines, wait_for, wait_for_stats, wait_reader_matched
 
 COUNT = 500
 WARM_UP_MAX = 10000  # 20 s at 500 Hz at most; stopped once every rate reader got a sample
@@ -26,6 +26,7 @@ def body(h):
     slower = echo("slower", "robot_state_10hz", COUNT, 8)
     tenth = echo("tenth", "robot_state_tenth", COUNT, 8)
     wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "the full-rate reader to match")
+    wait_reader_matched(h, "full", "rsg_echo")
     # The rate readers are volatile: a warm-up stream (q and time only) runs until each got a sample,
     # so that the measured stream (every field) starts with every reader matched.
     warm_up = h.start("warm_up", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", RATE, "--count",

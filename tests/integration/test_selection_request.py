@@ -10,7 +10,7 @@ import struct
 import sys
 import zlib
 
-from harness import check, main, read_json, read_json_lines, wait_for_stats, free_udp_port
+from harness import check, main, read_json, read_json_lines, wait_for_stats, wait_reader_matched, free_udp_port
 
 COUNT = 600
 RATE = "300"
@@ -30,6 +30,7 @@ def sim_follows_the_request(h):
     echo = h.start("echo", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "robot_state",
                             "--json", "--count", str(COUNT), "--timeout", "45"])
     wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "rsg_echo's reader to match the gateway's writer")
+    wait_reader_matched(h, "echo", "rsg_echo")
 
     report_path = h.dir / "sim.report.json"
     status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", RATE, "--count", str(COUNT),

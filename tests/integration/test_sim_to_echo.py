@@ -2,7 +2,7 @@
 
 import sys
 
-from harness import check, main, read_json, read_json_lines, wait_for_stats, free_udp_port
+from harness import check, main, read_json, read_json_lines, wait_for_stats, wait_reader_matched, free_udp_port
 
 COUNT = 1000
 RATE = "500"
@@ -16,6 +16,7 @@ def body(h):
     echo = h.start("echo", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "robot_state",
                             "--json", "--count", str(COUNT), "--timeout", "45"])
     wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "rsg_echo's reader to match the gateway's writer")
+    wait_reader_matched(h, "echo", "rsg_echo")
 
     record, report = h.dir / "sim.record.jsonl", h.dir / "sim.report.json"
     # Changing selections: joints every frame, group 0 every third, everything every tenth.

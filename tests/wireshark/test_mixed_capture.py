@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
-from harness import TestFailure, check, main, wait_for, wait_for_stats, free_udp_port  # noqa: E402
+from harness import TestFailure, check, main, wait_for, wait_for_stats, wait_reader_matched, free_udp_port  # noqa: E402
 
 import tshark_run  # noqa: E402
 
@@ -38,6 +38,7 @@ def body(h):
     echo = h.start("echo", [h.binary("rsg_echo"), "--domain", str(h.domain), "--json", "--count", str(COUNT),
                             "--timeout", "30"])
     wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "rsg_echo to match the gateway")
+    wait_reader_matched(h, "echo", "rsg_echo")
     for index, port in enumerate(ports):
         status = h.run(f"sim{index}", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "500",
                                        "--count", str(COUNT), "--every", "1:q,time", "--every", "7:all"])

@@ -22,6 +22,7 @@
 #include <thread>
 
 #include "live_table.hpp"
+#include "matched_writers.hpp"
 #include "rsg/dds/discovery_cli.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
@@ -206,7 +207,9 @@ int run(const Options& options) {
   StopOnSignal stop_on_signal([&stop] { stop.set_trigger_value(true); });
   fdds::StatusCondition& reader_condition = reader->get_statuscondition();
   reader_condition.set_enabled_statuses(fdds::StatusMask::data_available()
-                                        << fdds::StatusMask::requested_incompatible_qos());
+                                        << fdds::StatusMask::requested_incompatible_qos()
+                                        << fdds::StatusMask::subscription_matched());
+  rsg::tools::MatchedWriters matched_writers("rsg_echo", read_topic);
   fdds::WaitSet waitset;
   waitset.attach_condition(reader_condition);
   waitset.attach_condition(stop);
@@ -225,6 +228,7 @@ int run(const Options& options) {
     waitset.wait(triggered,
                  eprosima::fastrtps::Duration_t(
                      0, static_cast<std::uint32_t>(std::chrono::nanoseconds(kRefreshPeriod).count())));
+    matched_writers.update(*reader);
     const auto now = Clock::now();
     if (stop.get_trigger_value()) {
       sink.flush(now, /*force_table=*/true);

@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 
+#include "matched_writers.hpp"
 #include "mcap_writer.hpp"
 #include "monitor_options.hpp"
 #include "monitor_readers.hpp"
@@ -189,6 +190,7 @@ int run(const Options& options, rsg::record::Profile profile) {
   const auto start = std::chrono::steady_clock::now();
   const auto duration = std::chrono::duration<double>(options.duration_s);
   LossCounter loss;
+  rsg::tools::MatchedWriters matched_writers("rsg_record", options.topic);
   rsg::RobotState state;
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
@@ -207,6 +209,7 @@ int run(const Options& options, rsg::record::Profile profile) {
     while (!readers.stop_requested() &&
            (options.duration_s == 0 || std::chrono::steady_clock::now() - start < duration)) {
       readers.wait(kBatchPeriod);
+      matched_writers.update(readers.state());
       write_what_was_received();
       recording.tick();
     }
