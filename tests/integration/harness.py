@@ -10,6 +10,7 @@ import os
 import shutil
 import signal
 import socket
+import struct
 import subprocess
 import sys
 import tempfile
@@ -191,26 +192,74 @@ def wait_for_stats(stats_path, predicate, what, timeout_s=DEFAULT_WAIT_S):
     return wait_for(lambda: (lambda s: s if s and predicate(s) else None)(read_json(stats_path)), what, timeout_s)
 
 
+# Linux's socket option for arrival times in nanoseconds (asm-generic/socket.h); Python's socket
+# module does not name it.
+SO_TIMESTAMPNS = 35
+
+
+def timed_receiver():
+    """A UDP socket on 127.0.0.1 (any port) whose datagrams carry the kernel's arrival time, so that
+    a test process scheduled late does not shorten a span it measures."""
+    receiver = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    receiver.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4 << 20)
+    receiver.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
+    receiver.bind(("127.0.0.1", 0))
+    return receiver
+
+
+def receive_timed(receiver, count, timeout_s=10.0, quiet_s=0.3):
+    """`count` datagrams as (arrival time in s, bytes), then any that follow within `quiet_s` (a
+    test checks there are none; None: return at once); fails when fewer than `count` arrive within
+    `timeout_s`."""
+    received = []
+    deadline = time.monotonic() + timeout_s
+    while True:
+        if len(received) >= count and quiet_s is None:
+            return received
+        left = deadline - time.monotonic() if len(received) < count else quiet_s
+        if left <= 0:
+            raise TestFailure(f"received {len(received)} of {count} datagrams within {timeout_s:.0f} s")
+        receiver.settimeout(left)
+        try:
+            received.append(_timed_datagram(receiver))
+        except socket.timeout:
+            if len(received) >= count:
+                return received
+
+
+def _timed_datagram(receiver):
+    data, ancillary, _, _ = receiver.recvmsg(65536, socket.CMSG_SPACE(16))
+    stamp = next((item for level, kind, item in ancillary if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS),
+                 None)
+    check(stamp is not None, "a datagram without its kernel arrival time")
+    seconds, nanoseconds = struct.unpack("qq", stamp[:16])
+    return seconds + nanoseconds * 1e-9, data
+
+
 class UdpRelay(threading.Thread):
-    """Receives on `port`, records every datagram, forwards it to `forward_to` (when given)."""
+    """Receives on `port`, records every datagram and its kernel arrival time (`times`, in s),
+    forwards it to `forward_to` (when given)."""
 
     def __init__(self, port, forward_to=None):
         super().__init__(daemon=True)
         self.socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4 << 20)
+        self.socket.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
         self.socket.bind(("127.0.0.1", port))
         self.socket.settimeout(0.2)
         self.forward_to = forward_to
         self.datagrams = []
+        self.times = []
         self.stopping = False
 
     def run(self):
         while not self.stopping:
             try:
-                datagram, _ = self.socket.recvfrom(65536)
+                arrival, datagram = _timed_datagram(self.socket)
             except socket.timeout:
                 continue
             self.datagrams.append(datagram)
+            self.times.append(arrival)
             if self.forward_to:
                 self.socket.sendto(datagram, self.forward_to)
 

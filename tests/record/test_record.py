@@ -18,8 +18,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "integration"))
-from harness import (UdpRelay, check, free_udp_port, main, read_json_lines, wait_for,  # noqa: E402
-                     wait_for_stats, wait_reader_matched)
+from harness import (UdpRelay, check, free_udp_port, main, read_json_lines, receive_timed,  # noqa: E402
+                     timed_receiver, wait_for, wait_for_stats, wait_reader_matched)
 
 CASE = sys.argv[sys.argv.index("--case") + 1]
 del sys.argv[sys.argv.index("--case"):sys.argv.index("--case") + 2]
@@ -149,7 +149,9 @@ def write_errors(h):
 def replay_roundtrip(h):
     """record -> replay -> gateway -> rsg_echo --json gives the original stream exactly, and the
     replayed datagrams are byte for byte the ones the first gateway received; --domain replays the
-    samples over DDS to the same effect."""
+    samples over DDS to the same effect. The frames keep the recording's spacing divided by --speed
+    (1 and 2; a lower bound on the span from the first to the last arrival), and --loop plays the
+    file again, the same frames, right after its end."""
     count = 1200
     port, gateway, stats, rec, out = gateway_with_recorder(h)
     tap_port = free_udp_port()
@@ -188,6 +190,28 @@ def replay_roundtrip(h):
     received = read_json_lines(h.output("echo"))
     check(received == sent, "rsg_echo's stream after the replay differs from what rsg_sim sent")
     check(h.stop("gateway2", gateway2) == 0, "the second gateway did not exit 0")
+    # The file's publish times are the first gateway's, stamped as it received each frame from the tap.
+    span_s = tap.times[-1] - tap.times[0]
+    took = tap2.times[-1] - tap2.times[0]
+    print(f"[{h.name}] recorded over {span_s:.3f} s, replayed at --speed 2 in {took:.3f} s", flush=True)
+    check(took >= 0.8 * span_s / 2, f"--speed 2 replayed {span_s:.3f} s of frames in {took:.3f} s")
+
+    # --loop at the original timing, until SIGINT: a second pass of the same frames follows the first.
+    receiver = timed_receiver()
+    looping = h.start("replay_loop", [h.binary("rsg_replay"), str(out), "--to",
+                                      f"127.0.0.1:{receiver.getsockname()[1]}", "--loop"])
+    again = count // 4
+    looped = receive_timed(receiver, count + again, timeout_s=30, quiet_s=None)
+    looping.send_signal(signal.SIGINT)
+    check(h.wait("replay_loop", looping, 10) == 0, f"rsg_replay --loop did not exit 0 on SIGINT: "
+          f"{stderr_of(h, 'replay_loop')}")
+    receiver.close()
+    frames = [data for _, data in looped]
+    check(frames[:count] == tap.datagrams, "the first pass of --loop differs from the frames the gateway received")
+    check(frames[count:] == tap.datagrams[:again], "the second pass of --loop does not play the file from its start")
+    took = looped[count - 1][0] - looped[0][0]
+    print(f"[{h.name}] the first pass of --loop took {took:.3f} s", flush=True)
+    check(took >= 0.8 * span_s, f"rsg_replay played {span_s:.3f} s of frames in {took:.3f} s at their original timing")
 
     # DDS: replay --domain -> rsg_echo --json.
     echo2 = h.start("echo2", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "dds_replayed", "--json",

@@ -11,6 +11,12 @@
 //                       decoded with Foxglove's ROS 2 decoder, equal the IDL ones. The last status
 //                       (one that counts all N frames published) is printed for the driver to compare
 //                       with the gateway's own counters.
+//        [--groups G]   a view: only the frames carrying all groups of the bit mask G arrive (N of them)
+//        [--sent M]     rsg_sim sent M frames (default N); the last status must count M published,
+//                       and no status may count more (one from another gateway would)
+//        [--unsubscribe-after K]  with --ros2: after K states, unsubscribe from the ROS 2 RobotState
+//                       channel; once the server has answered a later request, none of its messages
+//                       may arrive while the other subscriptions keep flowing
 //
 // Prints "ready" once subscribed (the driver then starts the simulator) and one JSON line at the
 // end; exits 1 with the reason on the first mismatch.
@@ -32,6 +38,10 @@ const count = Number(option("--count"));
 const framesPath = option("--frames");
 const malformed = flag("--malformed");
 const ros2Dir = option("--ros2");
+const groups = Number(option("--groups") ?? 0);
+const sent = Number(option("--sent") ?? count);
+const unsubscribeAfter = option("--unsubscribe-after") === undefined ? undefined : Number(option("--unsubscribe-after"));
+if (unsubscribeAfter !== undefined && !ros2Dir) fail("--unsubscribe-after needs --ros2");
 const timeout = setTimeout(() => fail(`timed out: ${JSON.stringify(progress())}`), Number(option("--timeout") ?? 60) * 1000);
 
 const offered = flavour === "sdk" ? "foxglove.sdk.v1" : FoxgloveClient.SUPPORTED_SUBPROTOCOL;
@@ -40,7 +50,7 @@ const ws = new WebSocket(url, [offered]);
 // The same events from both clients: serverInfo, advertise, status, message {subscriptionId, data}.
 const handlers = {};
 const on = (name, handler) => (handlers[name] = handler);
-let subscribe;
+let subscribe, unsubscribe;
 let sendRaw = (text) => ws.send(text);
 if (flavour === "sdk") {
   ws.binaryType = "nodebuffer";
@@ -50,6 +60,7 @@ if (flavour === "sdk") {
     ws.send(JSON.stringify({ op: "subscribe", subscriptions: [{ id, channelId }] }));
     return id;
   };
+  unsubscribe = (id) => ws.send(JSON.stringify({ op: "unsubscribe", subscriptionIds: [id] }));
   ws.on("open", () => check(ws.protocol === "foxglove.sdk.v1", `server answered subprotocol '${ws.protocol}'`));
   ws.on("message", (data, isBinary) => {
     if (!isBinary) {
@@ -69,6 +80,7 @@ if (flavour === "sdk") {
 } else {
   const client = new FoxgloveClient({ ws });
   subscribe = (channelId) => client.subscribe(channelId);
+  unsubscribe = (id) => client.unsubscribe(id);
   for (const name of ["serverInfo", "advertise", "status", "message"]) client.on(name, (event) => handlers[name]?.(event));
   client.on("error", (error) => fail(`client error: ${error.message}`));
   client.on("open", () => check(ws.protocol === FoxgloveClient.SUPPORTED_SUBPROTOCOL, `subprotocol '${ws.protocol}'`));
@@ -139,13 +151,26 @@ function start() {
   sendRaw(JSON.stringify({ op: "getParameters", parameterNames: [] }));
   on("status", (message) => {
     if (message.level === 2) errors.push(message.message);
-    if (message.message.includes("getParameters") && !started) {
+    if (!message.message.includes("getParameters")) return;
+    if (!started) {
       started = true;
       console.log("ready");
+    } else if (unsubscription?.answered === false) {
+      // Every message written after this answer was queued after the unsubscribe was handled.
+      Object.assign(unsubscription, { answered: true, states: states.length, statuses: statuses.length,
+                                      ros2: ros2States.length });
     }
   });
 }
 let started = false;
+let unsubscription;  // {id, answered, and the counts when the server's answer arrived}
+
+function unsubscribeRos2States() {
+  const id = [...subscriptions].find(([, kind]) => kind === "ros2")[0];
+  unsubscription = { id, answered: false };
+  unsubscribe(id);
+  sendRaw(JSON.stringify({ op: "getParameters", parameterNames: [] }));
+}
 
 on("message", ({ subscriptionId, data }) => {
   const kind = subscriptions.get(subscriptionId);
@@ -153,9 +178,13 @@ on("message", ({ subscriptionId, data }) => {
   const bytes = new Uint8Array(data.buffer, data.byteOffset, data.byteLength);
   if (kind === "state") states.push(stateReader.readMessage(bytes));
   else if (kind === "status") statuses.push(statusReader.readMessage(bytes));
-  else if (kind === "ros2") ros2States.push(ros2Reader.readMessage(bytes));
+  else if (kind === "ros2") {
+    check(!unsubscription?.answered, `a message of subscription ${subscriptionId} after it was unsubscribed`);
+    ros2States.push(ros2Reader.readMessage(bytes));
+  }
   else if (kind === "ros2_status") ros2Statuses.push(ros2StatusReader.readMessage(bytes));
   else transforms.push(JSON.parse(new TextDecoder().decode(bytes)));
+  if (kind === "state" && states.length === unsubscribeAfter) unsubscribeRos2States();
   if (states.length >= count && lastStatusArrived() && !finishing) {
     finishing = true;
     finish();
@@ -167,7 +196,7 @@ let finishing = false;
 // within a second of the last frame); without: any status.
 function lastStatusArrived() {
   if (!ros2Dir) return statuses.length >= 1;
-  const complete = (list) => list.length > 0 && Number(list[list.length - 1].frames_published) === count;
+  const complete = (list) => list.length > 0 && Number(list[list.length - 1].frames_published) === sent;
   return complete(statuses) && complete(ros2Statuses);
 }
 
@@ -182,9 +211,11 @@ function flatten(message, prefix = "", out = {}) {
 }
 
 async function finish() {
-  const frames = await waitForFrames(framesPath, count);
+  const frames = (await waitForFrames(framesPath, sent)).filter((frame) => (frame.group_select & groups) === groups);
   clearTimeout(timeout);
   check(states.length === frames.length, `${states.length} states received for ${frames.length} frames sent`);
+  const most = Math.max(...statuses.map((status) => Number(status.frames_published)));
+  check(most <= sent, `a status counts ${most} frames published of ${sent} sent: another gateway's?`);
   const translations = new Set();
   states.forEach((state, index) => {
     const frame = frames[index];
@@ -205,6 +236,13 @@ async function finish() {
     const text = (value) => JSON.stringify(ArrayBuffer.isView(value) ? [...value] : value,
                                            (key, v) => (typeof v === "bigint" ? v.toString() : v));
     check(ros2States.length > 0 && ros2States.length <= states.length, `${ros2States.length} ROS 2 messages`);
+    if (unsubscription) {
+      check(unsubscription.answered, "the server never answered the request after the unsubscribe");
+      check(ros2States.length === unsubscription.ros2 && ros2States.length < states.length,
+            `${ros2States.length} ROS 2 messages for ${states.length} states, ${unsubscription.ros2} when unsubscribed`);
+      check(states.length > unsubscription.states && statuses.length > unsubscription.statuses,
+            `the other subscriptions stopped with the unsubscribe: ${JSON.stringify(unsubscription)}`);
+    }
     ros2States.forEach((message, index) => {
       for (const [name, value] of Object.entries(states[index]))
         check(text(message[name.toLowerCase()]) === text(value), `ROS 2 message ${index}: ${name} differs`);
@@ -224,7 +262,7 @@ async function finish() {
     check(errors.some((e) => e.includes("no channel 12345")), `no error status for an unknown channel: ${errors}`);
   }
   console.log(JSON.stringify({ subprotocol: ws.protocol, ros2: ros2States.length, ros2_statuses: ros2Statuses.length,
-                               ...progress(), last_status: lastStatus }));
+                               ...progress(), unsubscription, last_status: lastStatus }));
   ws.close();
   process.exit(0);
 }

@@ -54,10 +54,10 @@ def flatten(value, prefix=""):
     return out
 
 
-def start_view(h, *flags):
+def start_view(h, *flags, gateway_flags=()):
     """A gateway and an rsg_view matched to its writer; returns (udp port, gateway, stats, view, ws port)."""
     port = free_udp_port()
-    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000")
+    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000", *gateway_flags)
     ws_port = free_tcp_port()
     view = h.start("view", [h.binary("rsg_view"), "--domain", str(h.domain), "--listen", f"127.0.0.1:{ws_port}",
                             *flags])
@@ -66,19 +66,26 @@ def start_view(h, *flags):
     return port, gateway, stats, view, ws_port
 
 
-def foxglove_client(h, subprotocol, *flags, count=600, rate=500, view_flags=(), before_sim=None):
-    """Every frame sent arrives through rsg_view, decoded by Foxglove's decoder to the values sent."""
-    port, gateway, stats, view, ws_port = start_view(h, *view_flags)
-    if before_sim:
-        before_sim(ws_port)
+def foxglove_client(h, subprotocol, *flags, count=600, rate=500, view_flags=(), gateway_flags=(), before_sim=None,
+                    groups=0):
+    """Every frame sent (of those carrying all `groups`, a bit mask, for a view) arrives through
+    rsg_view, decoded by Foxglove's decoder to the values sent. `before_sim(ws_port)` runs once the
+    client has subscribed."""
+    port, gateway, stats, view, ws_port = start_view(h, *view_flags, gateway_flags=gateway_flags)
+    # The frames SELECTIONS puts group 0 in (the only group a view here selects) or every group in.
+    check(groups in (0, 1), f"groups {groups}")
+    states = len([i for i in range(count) if not groups or i % 3 == 0 or i % 10 == 0])
     record = h.dir / "sim.record.jsonl"
     # The ros2msg channels exist when the build embedded rsg_msgs' .msg files (it does from this tree).
     msg_dir = ROOT / "ros2" / "rsg_msgs" / "msg"
     ros2 = ["--ros2", str(msg_dir)] if (msg_dir / "GatewayStatus.msg").exists() else []
     client = h.start("client", [node(), str(HERE / "check_view.mjs"), f"ws://127.0.0.1:{ws_port}", "--subprotocol",
-                                subprotocol, "--count", str(count), "--frames", str(record), *ros2, *flags])
+                                subprotocol, "--count", str(states), "--sent", str(count), "--groups", str(groups),
+                                "--frames", str(record), *ros2, *flags])
     wait_for(lambda: "ready" in h.output("client").read_text() or client.poll() is not None, "the client to subscribe")
     check(client.poll() is None, f"the client failed: {(h.dir / 'client.err').read_text()}")
+    if before_sim:
+        before_sim(ws_port)
     status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", str(rate), "--count", str(count),
                            "--record", str(record), *SELECTIONS])
     check(status == 0, f"rsg_sim exited {status}")
@@ -86,7 +93,7 @@ def foxglove_client(h, subprotocol, *flags, count=600, rate=500, view_flags=(), 
     result = json.loads(h.output("client").read_text().splitlines()[-1])
     print(f"[{h.name}] client: {result}", flush=True)
     expected = "foxglove.sdk.v1" if subprotocol == "sdk" else "foxglove.websocket.v1"
-    check(result["subprotocol"] == expected and result["states"] == count, f"client saw {result}")
+    check(result["subprotocol"] == expected and result["states"] == states, f"client saw {result}")
     if ros2:
         # The last GatewayStatus, decoded from the ros2msg channel, holds the gateway's own counters
         # (its --stats-file; the nested invalid counts spelled out as in the .msg). Rate and link
@@ -111,8 +118,34 @@ def foxglove_legacy(h):
 
 
 def foxglove_sdk(h):
-    """A client offering foxglove.sdk.v1 (the current Foxglove app) gets that subprotocol and the same data."""
-    foxglove_client(h, "sdk")
+    """A client offering foxglove.sdk.v1 (the current Foxglove app) gets that subprotocol and the same
+    data. It unsubscribes from /robot_state (ROS 2) after 200 samples: no message of that
+    subscription arrives after the server's answer to its next request, while every sample keeps
+    arriving on the IDL channel, and statuses too."""
+    result = foxglove_client(h, "sdk", "--unsubscribe-after", "200")
+    check(result["unsubscription"]["answered"] and result["ros2"] < result["states"], f"unsubscribe: {result}")
+
+
+def view_and_partition(h):
+    """rsg_view --partition robot1 --view view_poses, with a second gateway on partition robot2 on the
+    same domain and topics, fed at the same time: the client gets exactly robot1's frames that carry
+    group 0 (view_poses), decoded to the values sent, and no status of robot2's gateway (which counts
+    more frames than robot1's)."""
+    other_port = free_udp_port()
+    other, other_stats = h.gateway("gateway_robot2", "--listen", f"127.0.0.1:{other_port}", "--expected-rate", "1000",
+                                   "--partition", "robot2")
+    wait_for_stats(other_stats, lambda s: True, "robot2's gateway to start")
+    other_sim = {}
+
+    def feed_robot2(ws_port):
+        other_sim["process"] = h.start("sim_robot2", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{other_port}", "--rate",
+                                                      "1000", "--count", "900", "--seed", "7", "--every", "1:g0"])
+
+    foxglove_client(h, "legacy", view_flags=("--partition", "robot1", "--view", "view_poses"),
+                    gateway_flags=("--partition", "robot1"), before_sim=feed_robot2, groups=1)
+    check(h.wait("sim_robot2", other_sim["process"], 30) == 0, "robot2's rsg_sim failed")
+    wait_for_stats(other_stats, lambda s: s["frames_published"] == 900, "robot2's gateway to publish its 900 frames")
+    check(h.stop("gateway_robot2", other) == 0, "robot2's gateway did not exit 0")
 
 
 def slow_client(h):
