@@ -5,7 +5,7 @@ invalid frames. tshark (Debian's, not rsg's code) confirms the capture holds eve
 import subprocess
 import sys
 
-from harness import check, main, read_json, read_json_lines, wait_for_stats, free_udp_port
+from harness import check, main, read_json, read_json_lines, wait_for_stats, wait_reader_matched, free_udp_port
 
 COUNT = 300
 RATE = "500"
@@ -23,6 +23,7 @@ def run_gateway_and_echo(h, label, send_argv_for_port):
     echo = h.start(f"echo_{label}", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", topic, "--json",
                                      "--count", str(VALID), "--timeout", "45"])
     wait_for_stats(stats, lambda s: s["state_readers"] >= 1, f"the {label} rsg_echo to match")
+    wait_reader_matched(h, f"echo_{label}", "rsg_echo")
     status = h.run(f"sender_{label}", send_argv_for_port(port))
     check(status == 0, f"the {label} sender exited {status}")
     check(h.wait(f"echo_{label}", echo, 45) == 0, f"the {label} rsg_echo did not receive every sample")

@@ -18,6 +18,7 @@ import sys
 from reliability import (check, check_counters, check_delivered_exactly_once, log, main, read_json_lines,
                          run_sim, settled_stats, start_gateway, start_logger, stop_child, wait_for,
                          wait_for_readers)
+from harness import wait_reader_matched  # noqa: E402
 
 RATE_HZ = 5000
 COUNT = 100_000
@@ -29,6 +30,7 @@ def body(h):
     h.start("status_probe", [h.binary("rsg_status_probe"), "--domain", str(h.domain), "--timeout", "80"])
     logger = start_logger(h, "logger", timeout_s=60)
     wait_for_readers(stats, 1)
+    wait_reader_matched(h, "logger", "rsg_echo")
 
     report, record, seconds = run_sim(h, port, RATE_HZ, COUNT, *SELECTION, "--corrupt", "0.05", "--seed", "5000")
     log(h, f"MEASURED sent {report['sent']} datagrams in {seconds:.1f} s ({report['sent'] / seconds:.0f}/s), "

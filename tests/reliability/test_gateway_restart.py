@@ -18,6 +18,7 @@ import sys
 
 from reliability import (DeadlineProbe, check, fastdds_shm_segments, log, main, measured, monotonic,
                          read_json_lines, start_gateway, start_logger, stop_child, wait_for, wait_for_readers)
+from harness import wait_reader_matched  # noqa: E402
 
 RATE_HZ = 1000
 COUNT = 8000  # 8 s: the kill comes after ~2 s, so the restarted gateway streams for several seconds
@@ -45,6 +46,7 @@ def body(h):
     probe = DeadlineProbe(h)
     logger = start_logger(h, "logger")
     wait_for_readers(stats, 2)
+    wait_reader_matched(h, "logger", "rsg_echo")
 
     record = h.dir / "sim.record.jsonl"
     sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", str(RATE_HZ),

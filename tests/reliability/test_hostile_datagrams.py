@@ -17,6 +17,7 @@ import sys
 from reliability import (check, check_delivered_exactly_once, log, main, read_json, run_sim, start_gateway,
                          start_logger, stop_child, udp_socket_drops, vm_kib, wait_for, wait_for_readers,
                          wait_for_stats)
+from harness import wait_reader_matched  # noqa: E402
 
 RATE_HZ = 1000
 OVERSIZED = (2138, 9000, 30000, 65507)
@@ -62,6 +63,7 @@ def body(h):
     gateway, stats, port = start_gateway(h, RATE_HZ)
     logger = start_logger(h, "logger", timeout_s=80)
     wait_for_readers(stats, 1)
+    wait_reader_matched(h, "logger", "rsg_echo")
 
     # Paced: every datagram reaches the gateway, so every counter is exact.
     start = gateway_counts(read_json(stats))

@@ -12,6 +12,7 @@ import sys
 
 from reliability import (BusyLoop, check, check_counters, check_delivered_exactly_once, main, run_sim,
                          settled_stats, start_gateway, start_logger, stop_child, wait_for_readers)
+from harness import wait_reader_matched  # noqa: E402
 
 RATE_HZ = 1000
 COUNT = 10 * RATE_HZ
@@ -21,6 +22,7 @@ def body(h):
     gateway, stats, port = start_gateway(h, RATE_HZ)
     logger = start_logger(h, "logger")
     wait_for_readers(stats, 1)
+    wait_reader_matched(h, "logger", "rsg_echo")
 
     with BusyLoop(h, cpu=max(os.sched_getaffinity(0))):
         report, record, _ = run_sim(h, port, RATE_HZ, COUNT, "--fields", "q,time")

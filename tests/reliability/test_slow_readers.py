@@ -19,6 +19,7 @@ import sys
 from reliability import (DeadlineProbe, check, check_counters, check_delivered_exactly_once, log, logged_samples,
                          main, monotonic, read_json, settled_stats, start_gateway, start_logger, stop_child,
                          wait_for, wait_for_readers)
+from harness import wait_reader_matched  # noqa: E402
 
 RATE_HZ = 1000
 COUNT = 9000
@@ -31,6 +32,8 @@ def body(h):
     probe = DeadlineProbe(h)
     witness, frozen, doomed = (start_logger(h, label) for label in ("witness", "frozen", "killed"))
     wait_for_readers(stats, 4)
+    for label in ("witness", "frozen", "killed"):
+        wait_reader_matched(h, label, "rsg_echo")
 
     record, report_path = h.dir / "sim.record.jsonl", h.dir / "sim.report.json"
     sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", str(RATE_HZ),

@@ -17,7 +17,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "integration"))
-from harness import check, free_udp_port, main, read_json_lines, wait_for, wait_for_stats  # noqa: E402
+from harness import check, free_udp_port, main, read_json_lines, wait_for, wait_for_stats, wait_reader_matched  # noqa: E402
 
 CASE = sys.argv[sys.argv.index("--case") + 1]
 del sys.argv[sys.argv.index("--case"):sys.argv.index("--case") + 2]
@@ -62,6 +62,7 @@ def start_view(h, *flags, gateway_flags=()):
     view = h.start("view", [h.binary("rsg_view"), "--domain", str(h.domain), "--listen", f"127.0.0.1:{ws_port}",
                             *flags])
     wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "rsg_view's reader to match the gateway's writer")
+    wait_reader_matched(h, "view", "rsg_view")
     wait_for(lambda: "serving" in (h.dir / "view.err").read_text(), "rsg_view to listen")
     return port, gateway, stats, view, ws_port
 

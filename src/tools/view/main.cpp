@@ -15,6 +15,7 @@
 #include <optional>
 #include <sstream>
 
+#include "matched_writers.hpp"
 #include "monitor_options.hpp"
 #include "monitor_readers.hpp"
 #include "recording.hpp"
@@ -122,8 +123,10 @@ int run(const Options& options) {
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
   bool summary_pending = false;
+  rsg::tools::MatchedWriters matched_writers("rsg_view", options.topic);
   while (!readers.stop_requested()) {
     readers.wait(kWakeUp);
+    matched_writers.update(readers.state());
     while (readers.state().take_next_sample(&state, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
       const std::uint64_t time = now_ns();
