@@ -14,7 +14,7 @@ installed=$(cd "$work/prefix/include/rsg" && find . -name '*.hpp' | sort)
 for header in $installed; do
   case "$header" in ./wire/* | ./transport/* | ./dds/* | ./gateway/embedded_gateway.hpp) ;; *) echo "FAIL: internal header installed: $header"; exit 1 ;; esac
 done
-for tool in rsg_gateway rsg_sim rsg_echo rsg_frame rsg_record rsg_replay; do
+for tool in rsg_gateway rsg_sim rsg_echo rsg_frame rsg_record rsg_replay rsg_view; do
   [[ -x "$work/prefix/bin/$tool" ]] || { echo "FAIL: $tool not installed"; exit 1; }
 done
 [[ -f "$work/prefix/share/rsg/idl/RobotState.idl" ]] || { echo "FAIL: IDL not installed"; exit 1; }
