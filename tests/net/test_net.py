@@ -1,7 +1,8 @@
 """rsg across hosts: the simulator on `robot`, the gateway on `gw`, readers on `ops1` and `ops2`,
 each a network namespace joined by a bridge (netbed.py). One scenario per run:
 
-    test_net.py SCENARIO --bin DIR      SCENARIO: stream, views, discovery, faults, restart
+    test_net.py SCENARIO --bin DIR      SCENARIO: stream, views, discovery, faults, restart,
+                                        multicast
 
 Every scenario compares what readers printed with the simulator's record, line for line (as
 digests: see netbed.LineDigests), and counts packets with nftables where the claim is about the
@@ -375,7 +376,68 @@ def restart(run, h):
     check(h.stop("gateway2", gateway) == 0, "the second gateway did not exit 0 on SIGTERM")
 
 
-SCENARIOS = {"stream": stream, "views": views, "discovery": discovery, "faults": faults, "restart": restart}
+# ----- 6. multicast delivery ------------------------------------------------------------------------------
+
+# rsg_participant_multicast's group (xml_profiles/rsg.xml).
+MULTICAST_GROUP = "239.255.100.1"
+MULTICAST_FRAMES = 4000
+# Two readers on each consumer host.
+READER_HOSTS = ("ops1", "ops1", "ops2", "ops2")
+
+
+def multicast(run, h):
+    """Four remote reliable readers (two on ops1, two on ops2), first with rsg's default participant
+    (unicast), then with rsg_participant_multicast. Each time every reader prints every frame exactly
+    once, and nftables on gw counts the sample datagrams leaving it (one datagram per copy: the
+    output hook sees them before IP fragmentation): about four copies per sample with unicast, about
+    one with multicast."""
+    readers_ip = "{ " + ", ".join(HOSTS[host] for host in ("ops1", "ops2")) + " }"
+    big = f"meta l4proto udp ip length > {BIG_DATAGRAM}"
+    read_gw = run.bed.counters("gw", {"unicast": ("output", f"oifname eth0 ip daddr {readers_ip} {big}"),
+                                      "multicast": ("output", f"oifname eth0 ip daddr {MULTICAST_GROUP} {big}"),
+                                      "other_if": ("output", f"oifname != eth0 ip daddr {MULTICAST_GROUP} {big}")})
+    read_ops = {host: run.bed.counters(host, {"multicast": ("input", f"ip daddr {MULTICAST_GROUP} {big}")})
+                for host in ("ops1", "ops2")}
+    gateway, stats = run.gateway()
+    copies = {}
+    for mode, flags in (("unicast", []), ("multicast", ["--participant-profile", "rsg_participant_multicast"])):
+        readers = [run.reader(host, f"echo_{mode}{index}", *flags) for index, host in enumerate(READER_HOSTS)]
+        wait_readers(stats, len(readers))
+        time.sleep(1.0)  # discovery's last large datagrams (endpoint announcements) are not samples
+        read_gw.reset()
+        for read in read_ops.values():
+            read.reset()
+        process, sent, report = run.sim(f"sim_{mode}", "--rate", "1000", "--count", MULTICAST_FRAMES, "--seed",
+                                        len(copies) + 3)
+        report, _ = run.finish_sim(f"sim_{mode}", process, sent, report, 60)
+        for index, (_, reader) in enumerate(readers):
+            check_exactly_once(f"echo_{mode}{index}", reader, sent.digests)
+        time.sleep(0.5)  # heartbeats and acknowledgements of the last samples
+        counted = read_gw()
+        received = {host: read()["multicast"][0] for host, read in read_ops.items()}
+        unicast, group = counted["unicast"][0], counted["multicast"][0]
+        copies[mode] = (unicast + group) / MULTICAST_FRAMES
+        log(h, f"MEASURED {mode}: {len(readers)} readers each printed all {MULTICAST_FRAMES} frames once; gw sent "
+               f"{unicast} unicast + {group} multicast sample datagrams out of eth0 = {copies[mode]:.2f} per sample "
+               f"(and {counted['other_if'][0]} to the group on other interfaces); multicast sample datagrams "
+               f"received: {received}")
+        if mode == "multicast":
+            for host, count in received.items():
+                check(count >= MULTICAST_FRAMES, f"{host} received {count} multicast sample datagrams for "
+                                                 f"{MULTICAST_FRAMES} samples: the samples did not come by multicast")
+        for index, (process, _) in enumerate(readers):
+            check(h.stop(f"echo_{mode}{index}", process) == 0, f"echo_{mode}{index} did not exit 0 on SIGTERM")
+        wait_for_stats(stats, lambda s: s["state_readers"] == 0, "the readers to unmatch")
+    check_gateway_total(stats, 2 * MULTICAST_FRAMES)
+    check(copies["unicast"] >= 3.5, f"unicast: {copies['unicast']:.2f} copies per sample for 4 remote readers "
+                                    f"(expected about 4): the counters do not count the samples")
+    check(copies["multicast"] <= 1.3, f"multicast: {copies['multicast']:.2f} copies per sample for 4 readers "
+                                      f"sharing a group (expected about 1)")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+
+
+SCENARIOS = {"stream": stream, "views": views, "discovery": discovery, "faults": faults, "restart": restart,
+             "multicast": multicast}
 
 
 def body(h):
