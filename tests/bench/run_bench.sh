@@ -22,6 +22,8 @@
 #         (scale.json, scale.md, PNG plots), with the Discovery Server. About 3 minutes, plus the
 #         wait for an idle host before each point (up to 2 minutes each).
 #         RSG_BENCH_SCALE_SECONDS   measuring window per point (default 8)
+#         RSG_BENCH_SCALE_SERIES    scale.py --series (default robots,readers; add readers_multicast
+#                                   for M readers of rsg_participant_multicast: four more points)
 #
 # A suite is a function run_<suite> that writes its results under $out and a function
 # report_<suite> that prints them, plus its name in SUITES.
@@ -124,7 +126,7 @@ PY
 }
 run_scale() {
   python3 "$here/scale.py" --bin "$build/bin" --out "$out/scale" --seconds "${RSG_BENCH_SCALE_SECONDS:-8}" \
-    --discovery-server >/dev/null
+    --series "${RSG_BENCH_SCALE_SERIES:-robots,readers}" --discovery-server >/dev/null
 }
 report_scale() { cat "$out/scale/scale.md"; }
 

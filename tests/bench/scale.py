@@ -1,12 +1,16 @@
 """`make bench` scale suite: how rsg's cost grows with robots and with remote readers.
 
     scale.py --bin BUILD/bin --out DIR [--seconds 8] [--points 1,4,8,16] [--discovery-server]
+             [--series robots,readers,readers_multicast]
 
 Runs on the network-namespace bed of tests/net (netbed.py): robots on `robot`, gateways on
 `gw`, readers on `ops1`/`ops2`, so every reader is remote (UDP over a veth bridge, MTU 1500).
 
   robots N:  N x (robot 1 kHz full frames -> own rsg_gateway, partition robotK -> one reader)
   readers M: one robot + rsg_gateway -> M readers (half on ops1, half on ops2)
+  readers_multicast M: the same with readers of rsg_participant_multicast (xml_profiles/rsg.xml):
+             the gateway sends one datagram per sample to their group instead of one per reader
+             (not in the default --series: `make bench` runs robots and readers)
 
 Robots and readers are rsg_bench_scale_probe (scale_probe.cpp): the robot sends the e2e suite's
 stamped full frames (index and CLOCK_MONOTONIC send time in the frame), each reader stamps every
@@ -95,9 +99,10 @@ def read_json(path):
 class Point:
     """One measured configuration: `robots` gateways, `readers` readers per gateway."""
 
-    def __init__(self, args, bed, scratch, robots, readers):
+    def __init__(self, args, bed, scratch, robots, readers, participant_profile="rsg_participant"):
         self.args, self.bed, self.dir = args, bed, Path(scratch)
         self.robots, self.readers = robots, readers
+        self.participant_profile = participant_profile
         self.domain = os.getpid() % 100 + 100
         self.processes = []
         self.discovery = ["--discovery-server", f"{HOSTS['gw']}:{DS_PORT}"] if args.discovery_server else []
@@ -137,7 +142,8 @@ class Point:
                 arrivals.append(self.dir / f"arrivals{k}_{r}.txt")
                 self.start("ops1" if r % 2 == 0 else "ops2", f"reader{k}_{r}",
                            [b / "rsg_bench_scale_probe", "read", "--domain", self.domain, "--partition",
-                            f"robot{k}", "--out", arrivals[-1], "--capacity", capacity, *self.discovery])
+                            f"robot{k}", "--out", arrivals[-1], "--capacity", capacity,
+                            "--participant-profile", self.participant_profile, *self.discovery])
         time.sleep(self.args.warmup)
         running = [p for p in self.processes if p.poll() is None]
         cpu0 = [cpu_seconds(g.pid) for g in gateways]
@@ -276,30 +282,39 @@ def table(rows, x_key):
         f"{limit(r)} |\n" for r in rows)
 
 
+SERIES = {  # name: (x key, plot label, table heading, participant profile of the readers)
+    "robots": ("robots", "robots N (robot + gateway + reader each)", "N robots", "rsg_participant"),
+    "readers": ("readers_per_gateway", "remote readers M of one gateway", "M remote readers of one gateway",
+                "rsg_participant"),
+    "readers_multicast": ("readers_per_gateway", "remote multicast readers M of one gateway",
+                          "M remote multicast readers of one gateway (rsg_participant_multicast)",
+                          "rsg_participant_multicast"),
+}
+
+
 def render(out, results):
-    """Slopes (over the points the machine did not limit), table, plots."""
-    robots, readers = results["robots"], results["readers"]
-    results["slope_gateway_cpu_pct_per_robot"] = fit_slope([r["robots"] for r in free(robots)],
-                                                           [r["gateway_cpu_pct_total"] for r in free(robots)])
-    results["slope_gateway_cpu_pct_per_reader"] = fit_slope([r["readers_per_gateway"] for r in free(readers)],
-                                                            [r["gateway_cpu_pct_total"] for r in free(readers)])
-    results["slope_bed_cpu_pct_per_robot"] = fit_slope([r["robots"] for r in free(robots)], [r["bed_cpu_pct"] for r in free(robots)])
-    results["slope_bed_cpu_pct_per_reader"] = fit_slope([r["readers_per_gateway"] for r in free(readers)],
-                                                        [r["bed_cpu_pct"] for r in free(readers)])
+    """Slopes (over the points the machine did not limit), table, plots, for the series that ran."""
+    ran = [name for name in SERIES if results.get(name)]
+    sections, slopes = [], []
+    for name in ran:
+        x_key, x_label, heading, _ = SERIES[name]
+        rows, unit = results[name], "robot" if name == "robots" else "reader"
+        suffix = name.removeprefix("readers").removeprefix("robots")  # "" or "_multicast"
+        gateway = fit_slope([r[x_key] for r in free(rows)], [r["gateway_cpu_pct_total"] for r in free(rows)])
+        bed = fit_slope([r[x_key] for r in free(rows)], [r["bed_cpu_pct"] for r in free(rows)])
+        results[f"slope_gateway_cpu_pct_per_{unit}{suffix}"] = gateway
+        results[f"slope_bed_cpu_pct_per_{unit}{suffix}"] = bed
+        plot(out, f"scale_{name}", rows, x_key, x_label)
+        sections.append(f"## {heading}\n\n{table(rows, x_key)}\n")
+        slopes.append(f"{name}: gateway CPU {gateway:.2f} % of a core per {unit}, all rsg processes {bed:.1f} % "
+                      f"per {unit}; latency p50 / p99 us: {growth(rows, x_key)}")
     (out / "scale.json").write_text(json.dumps(results, indent=1) + "\n")
-    plot(out, "scale_robots", robots, "robots", "robots N (robot + gateway + reader each)")
-    plot(out, "scale_readers", readers, "readers_per_gateway", "remote readers M of one gateway")
     text = (f"# Scale suite ({results['cpu']}, {results['cores']} cores, {results['seconds']:.0f} s windows, "
             f"discovery server: {results['discovery_server']}, load average before {results['load_before'][0]:.1f})\n\n"
-            f"## N robots\n\n{table(robots, 'robots')}\n## M remote readers of one gateway\n\n"
-            f"{table(readers, 'readers_per_gateway')}\n"
-            f"Least-squares slopes over the points not machine-limited (over all of them where fewer than "
-            f"two were not): gateway CPU {results['slope_gateway_cpu_pct_per_robot']:.2f} % of a core per "
-            f"robot, {results['slope_gateway_cpu_pct_per_reader']:.2f} % per remote reader; all rsg processes "
-            f"{results['slope_bed_cpu_pct_per_robot']:.1f} % per robot (robot + gateway + reader), "
-            f"{results['slope_bed_cpu_pct_per_reader']:.1f} % per reader.\n\n"
-            f"Latency, robot's send to remote reader's receive (p50 / p99 us): {growth(robots, 'robots')}; "
-            f"{growth(readers, 'readers_per_gateway')}.\n")
+            + "".join(sections)
+            + "Least-squares slopes over the points not machine-limited (over all of them where fewer than "
+              "two were not), and latency from the robot's send to the remote reader's receive:\n\n"
+            + "".join(f"- {line}\n" for line in slopes))
     (out / "scale.md").write_text(text)
     print(text)
 
@@ -333,6 +348,8 @@ def main():
     parser.add_argument("--warmup", type=float, default=2.0)
     parser.add_argument("--points", default="1,4,8,16")
     parser.add_argument("--discovery-server", action="store_true")
+    parser.add_argument("--series", default="robots,readers",
+                        help="comma-separated, in order, from: " + ", ".join(SERIES))
     parser.add_argument("--quiet-wait", type=float, default=120.0,
                         help="before each point, wait up to this many seconds for the host to be idle")
     parser.add_argument("--render", help="only redo the table and plots of OUT/scale.json")
@@ -343,15 +360,20 @@ def main():
         render(out, json.loads(Path(args.render).read_text()))
         return
     points = [int(p) for p in args.points.split(",")]
+    series = args.series.split(",")
+    unknown = [name for name in series if name not in SERIES]
+    if unknown:
+        parser.error(f"--series: unknown {', '.join(unknown)} (known: {', '.join(SERIES)})")
     results = {"cpu": cpu_model(), "cores": os.cpu_count(), "seconds": args.seconds,
-               "discovery_server": args.discovery_server, "load_before": os.getloadavg(), "robots": [],
-               "readers": []}
+               "discovery_server": args.discovery_server, "load_before": os.getloadavg(),
+               **{name: [] for name in series}}
     with NetBed() as bed:
-        for sweep, x in [("robots", n) for n in points] + [("readers", m) for m in points]:
+        for sweep, x in [(name, n) for name in series for n in points]:
             quiet_after = wait_for_quiet(args.quiet_wait)
             with tempfile.TemporaryDirectory(prefix="rsg_scale_") as scratch:
                 row = Point(args, bed, scratch, robots=x if sweep == "robots" else 1,
-                            readers=x if sweep == "readers" else 1).measure()
+                            readers=1 if sweep == "robots" else x,
+                            participant_profile=SERIES[sweep][3]).measure()
             row["waited_for_quiet_s"] = quiet_after
             print(f"{sweep} {x}: {json.dumps(row)}", flush=True)
             results[sweep].append(row)

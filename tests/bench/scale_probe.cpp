@@ -4,9 +4,11 @@
 //   rsg_bench_scale_probe send --to HOST:PORT [--rate 1000] --duration S
 //       a robot: the e2e suite's stamped full frames (e2e/stamped_frames.hpp: frame index and
 //       CLOCK_MONOTONIC send time in elbow_d), paced on absolute deadlines
-//   rsg_bench_scale_probe read --domain D [--partition P] [--discovery-server ...] --out FILE
+//   rsg_bench_scale_probe read --domain D [--partition P] [--discovery-server ...]
+//                              [--participant-profile NAME] --out FILE
 //       a remote reader with rsg_echo's table-mode QoS (reader_realtime): stamps every sample on
-//       arrival and, on SIGTERM, writes "index sent_ns received_ns" per sample to FILE
+//       arrival and, on SIGTERM, writes "index sent_ns received_ns" per sample to FILE;
+//       --participant-profile rsg_participant_multicast makes it a multicast reader
 //
 // Network namespaces share the host's CLOCK_MONOTONIC, so received_ns - sent_ns is the latency
 // from the robot's send to the remote reader's receive across the bed's veth links, as the e2e
@@ -93,6 +95,7 @@ struct ReadOptions {
   std::vector<std::string> partitions;
   std::string out;
   std::size_t capacity = 120'000;  // 2 minutes at 1 kHz
+  std::string participant_profile = "rsg_participant";
   rsg::DiscoveryOptions discovery;
 };
 
@@ -100,10 +103,10 @@ int read(const ReadOptions& options) {
   // Blocked before DDS starts its threads, so that only sigwait below ever takes them.
   const sigset_t signals = stop_signals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-  rsg::load_profiles({}, "rsg_participant");
+  rsg::load_profiles({}, options.participant_profile);
   ArrivalLog log(options.capacity);
   {
-    rsg::Participant participant(options.domain, "rsg_participant", options.discovery);
+    rsg::Participant participant(options.domain, options.participant_profile, options.discovery);
     fdds::Topic& topic = *participant.robot_state_topic(options.topic);
     fdds::Subscriber& subscriber = *participant.subscriber(options.partitions);
     fdds::DataReader* reader =
@@ -167,6 +170,10 @@ int main(int argc, char** argv) {
   reader->add_option("--out", read_options.out, "Where to write 'index sent_ns received_ns' lines")
       ->required();
   reader->add_option("--capacity", read_options.capacity, "Samples kept at most")->capture_default_str();
+  reader
+      ->add_option("--participant-profile", read_options.participant_profile,
+                   "XML participant profile, e.g. rsg_participant_multicast")
+      ->capture_default_str();
   rsg::add_discovery_options(*reader, read_options.discovery);
   CLI11_PARSE(app, argc, argv);
   try {

@@ -1,7 +1,8 @@
 """rsg across hosts: the simulator on `robot`, the gateway on `gw`, readers on `ops1` and `ops2`,
 each a network namespace joined by a bridge (netbed.py). One scenario per run:
 
-    test_net.py SCENARIO --bin DIR      SCENARIO: stream, views, discovery, faults, restart
+    test_net.py SCENARIO --bin DIR      SCENARIO: stream, views, discovery, faults, restart,
+                                        multicast
 
 Every scenario compares what readers printed with the simulator's record, line for line (as
 digests: see netbed.LineDigests), and counts packets with nftables where the claim is about the
@@ -375,7 +376,102 @@ def restart(run, h):
     check(h.stop("gateway2", gateway) == 0, "the second gateway did not exit 0 on SIGTERM")
 
 
-SCENARIOS = {"stream": stream, "views": views, "discovery": discovery, "faults": faults, "restart": restart}
+# ----- 6. multicast delivery ------------------------------------------------------------------------------
+
+PROFILES_DIR = Path(__file__).resolve().parents[2] / "xml_profiles"
+# rsg_participant_multicast's group (xml_profiles/rsg.xml).
+MULTICAST_GROUP = "239.255.100.1"
+MULTICAST_FRAMES = 4000
+# Two readers on each consumer host.
+READER_HOSTS = ("ops1", "ops1", "ops2", "ops2")
+# A gateway participant whose UDP transport only uses gw's plant interface (docs/scaling.md): Fast DDS
+# 2.9 then opens no loopback output socket, which otherwise sends every multicast datagram once more.
+GATEWAY_ON_ETH0 = f"""<?xml version="1.0" encoding="UTF-8"?>
+<dds xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <profiles>
+    <transport_descriptors>
+      <transport_descriptor>
+        <transport_id>gw_eth0</transport_id>
+        <type>UDPv4</type>
+        <interfaceWhiteList><address>{HOSTS['gw']}</address></interfaceWhiteList>
+      </transport_descriptor>
+    </transport_descriptors>
+    <participant profile_name="gw_eth0">
+      <rtps>
+        <userTransports><transport_id>gw_eth0</transport_id></userTransports>
+        <useBuiltinTransports>false</useBuiltinTransports>
+      </rtps>
+    </participant>
+  </profiles>
+</dds>
+"""
+
+
+def multicast(run, h):
+    """Four remote reliable readers (two on ops1, two on ops2) of one gateway, three times: with rsg's
+    default participant (unicast), with rsg_participant_multicast, and the latter again with a gateway
+    whose transport is limited to gw's interface. Each time every reader prints every frame exactly
+    once, and nftables on gw counts the sample datagrams it sends (one datagram per copy: the output
+    hook sees them before IP fragmentation): about four per sample out of eth0 with unicast, about one
+    with multicast, plus one to loopback unless the gateway's transport leaves loopback out."""
+    profiles = h.dir / "profiles"
+    profiles.mkdir()
+    for source in PROFILES_DIR.glob("*.xml"):
+        (profiles / source.name).symlink_to(source)
+    (profiles / "gw_eth0.xml").write_text(GATEWAY_ON_ETH0)
+    readers_ip = "{ " + ", ".join(HOSTS[host] for host in ("ops1", "ops2")) + " }"
+    big = f"meta l4proto udp ip length > {BIG_DATAGRAM}"
+    read_gw = run.bed.counters("gw", {"unicast": ("output", f"oifname eth0 ip daddr {readers_ip} {big}"),
+                                      "multicast": ("output", f"oifname eth0 ip daddr {MULTICAST_GROUP} {big}"),
+                                      "other_if": ("output", f"oifname != eth0 ip daddr {MULTICAST_GROUP} {big}")})
+    read_ops = {host: run.bed.counters(host, {"multicast": ("input", f"ip daddr {MULTICAST_GROUP} {big}")})
+                for host in ("ops1", "ops2")}
+    multicast_readers = ["--participant-profile", "rsg_participant_multicast"]
+    modes = {"unicast": ([], []), "multicast": ([], multicast_readers),
+             "multicast_eth0": (["--profiles", profiles, "--participant-profile", "gw_eth0"], multicast_readers)}
+    copies, looped = {}, {}
+    for seed, (mode, (gateway_flags, reader_flags)) in enumerate(modes.items()):
+        gateway, stats = run.gateway(f"gateway_{mode}", *gateway_flags)
+        readers = [run.reader(host, f"echo_{mode}{index}", *reader_flags) for index, host in enumerate(READER_HOSTS)]
+        wait_readers(stats, len(readers))
+        time.sleep(1.0)  # discovery's last large datagrams (endpoint announcements) are not samples
+        read_gw.reset()
+        for read in read_ops.values():
+            read.reset()
+        process, sent, report = run.sim(f"sim_{mode}", "--rate", "1000", "--count", MULTICAST_FRAMES, "--seed",
+                                        seed + 3)
+        report, _ = run.finish_sim(f"sim_{mode}", process, sent, report, 60)
+        for index, (_, reader) in enumerate(readers):
+            check_exactly_once(f"echo_{mode}{index}", reader, sent.digests)
+        check_gateway(stats, report)
+        time.sleep(0.5)  # heartbeats and acknowledgements of the last samples
+        counted = read_gw()
+        received = {host: read()["multicast"][0] for host, read in read_ops.items()}
+        unicast, group = counted["unicast"][0], counted["multicast"][0]
+        copies[mode] = (unicast + group) / MULTICAST_FRAMES
+        looped[mode] = counted["other_if"][0] / MULTICAST_FRAMES
+        log(h, f"MEASURED {mode}: {len(readers)} readers each printed all {MULTICAST_FRAMES} frames once; gw sent "
+               f"{unicast} unicast + {group} multicast sample datagrams out of eth0 = {copies[mode]:.2f} per sample, "
+               f"and {counted['other_if'][0]} to the group on loopback; multicast sample datagrams received: "
+               f"{received}")
+        if mode != "unicast":
+            for host, count in received.items():
+                check(count >= MULTICAST_FRAMES, f"{mode}: {host} received {count} multicast sample datagrams for "
+                                                 f"{MULTICAST_FRAMES} samples: the samples did not come by multicast")
+        for index, (reader, _) in enumerate(readers):
+            check(h.stop(f"echo_{mode}{index}", reader) == 0, f"echo_{mode}{index} did not exit 0 on SIGTERM")
+        check(h.stop(f"gateway_{mode}", gateway) == 0, f"gateway_{mode} did not exit 0 on SIGTERM")
+    check(copies["unicast"] >= 3.5, f"unicast: {copies['unicast']:.2f} copies per sample for 4 remote readers "
+                                    f"(expected about 4): the counters do not count the samples")
+    for mode in ("multicast", "multicast_eth0"):
+        check(copies[mode] <= 1.3, f"{mode}: {copies[mode]:.2f} copies per sample out of eth0 for 4 readers sharing "
+                                   f"a group (expected about 1)")
+    check(looped["multicast_eth0"] == 0, f"the gateway limited to eth0 still sent {looped['multicast_eth0']:.2f} "
+                                         f"copies per sample to loopback")
+
+
+SCENARIOS = {"stream": stream, "views": views, "discovery": discovery, "faults": faults, "restart": restart,
+             "multicast": multicast}
 
 
 def body(h):
