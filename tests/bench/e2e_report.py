@@ -2,6 +2,7 @@
 """Merges the rsg_bench_e2e results of one run into results.json, results.md and latency_cdf.png.
 
     e2e_report.py RUN_DIR OUT_DIR
+    e2e_report.py --render OUT_DIR     (results.md again from OUT_DIR/results.json)
 
 RUN_DIR holds one <scenario>.json per scenario (and <scenario>.cdf for latency scenarios) and the
 suite's settings.json, as run_bench.sh's `e2e` suite writes them. The goals are judged here, from ratios of the same run,
@@ -226,8 +227,9 @@ def markdown(results):
         "and analysis in [e2e.md](e2e.md). One-way latency in µs, full 2137-byte frames at 1 kHz, same "
         "frames and same writer QoS (`rsg_state_writer`) everywhere.",
         "",
-        "| path | frames | lost | p50 | p90 | p99 | p99.9 | max | publisher CPU | load avg (1 min) |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| path | frames | lost | p50 | p90 | p99 | p99.9 | max | p50 / p99 at listener entry | publisher CPU | "
+        "load avg (1 min) |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for name, title in LATENCY_ROWS:
         run = results.get(name)
@@ -236,10 +238,17 @@ def markdown(results):
         frames = run.get("received", run.get("round_trips"))
         load = (run.get("load_average") or {}).get("start", [None])[0]
         cpu = run.get("gateway", {}).get("cpu_percent", run.get("writer_cpu_percent", run.get("publisher_cpu_percent")))
+        notified = run.get("reader_notified") or {}
+        at_listener = (f"{fmt(notified['p50_us'])} / {fmt(notified['p99_us'])}"
+                       if "p50_us" in notified and "p99_us" in notified else "–")
         lines.append(f"| {title} | {fmt(frames)} | {fmt(run.get('lost'))} | {fmt(run['p50_us'])} | "
                      f"{fmt(run['p90_us'])} | {fmt(run['p99_us'])} | {fmt(run.get('p99.9_us'))} | "
-                     f"{fmt(run['max_us'])} | {fmt(cpu) + ' %' if cpu is not None else '–'} | {fmt(load, 2)} |")
-    lines += ["", "Publisher CPU: the rsg_gateway process (gateway rows) or the plain writer process (Fast DDS "
+                     f"{fmt(run['max_us'])} | {at_listener} | {fmt(cpu) + ' %' if cpu is not None else '–'} | "
+                     f"{fmt(load, 2)} |")
+    lines += ["", "At listener entry: the same frames timed when the reader's listener is called, before "
+              "`take()`; the latency columns time them after `take()`. The two differ most with data-sharing, "
+              "where a reliable reader acknowledges inside `take()` (see latency_breakdown.md).",
+              "", "Publisher CPU: the rsg_gateway process (gateway rows) or the plain writer process (Fast DDS "
               "rows), the relay process (floor rows), all threads, as % of one core over the measured part. The floor relays "
               "receive a datagram, copy the stamp out at a fixed offset and write it, with no validation, each "
               "written directly on its DDS API (Cyclone: default writer QoS, reliable keep-last 1; Fast DDS: the "
@@ -345,6 +354,12 @@ unset multiplot
 
 
 def main():
+    if len(sys.argv) == 3 and sys.argv[1] == "--render":
+        # Only the table again, from a committed results.json (e.g. after a change of layout).
+        out_dir = Path(sys.argv[2])
+        results = read_json(out_dir / "results.json")
+        (out_dir / "results.md").write_text(markdown(results), encoding="utf-8")
+        return
     if len(sys.argv) != 3:
         sys.exit(__doc__)
     run_dir, out_dir = Path(sys.argv[1]), Path(sys.argv[2])
