@@ -53,7 +53,10 @@ constexpr FoldConstants fold_by(unsigned bits) {
 static_assert(fold_by(512).low == 0x1'5444'2BD4 && fold_by(512).high == 0x1'C6E4'1596);
 static_assert(fold_by(128).low == 0x1'7519'97D0 && fold_by(128).high == 0xCCAA'009E);
 
-constexpr std::size_t kChunksPerRound = 4;  // independent remainders, to cover the multiply latency
+// Independent remainders, to cover the multiply latency. Four already keep an Intel Xeon's
+// multiplier busy (a fold: 5 cycles latency, 2 cycles of VPCLMULQDQ throughput); eight measured no
+// faster there (docs/benchmarks/wire.md).
+constexpr std::size_t kChunksPerRound = 4;
 constexpr std::size_t kRoundBytes = kChunksPerRound * kChunkBytes;
 constexpr std::size_t kMinStitchedBytes = kRoundBytes;
 constexpr __mmask64 kWholeChunk = ~__mmask64{0};
