@@ -53,7 +53,10 @@ constexpr FoldConstants fold_by(unsigned bits) {
 static_assert(fold_by(512).low == 0x1'5444'2BD4 && fold_by(512).high == 0x1'C6E4'1596);
 static_assert(fold_by(128).low == 0x1'7519'97D0 && fold_by(128).high == 0xCCAA'009E);
 
-constexpr std::size_t kChunksPerRound = 4;  // independent remainders, to cover the multiply latency
+// Independent remainders, to cover the multiply latency. Four already keep an Intel Xeon's
+// multiplier busy (a fold: 5 cycles latency, 2 cycles of VPCLMULQDQ throughput); eight measured no
+// faster there (docs/benchmarks/wire.md).
+constexpr std::size_t kChunksPerRound = 4;
 constexpr std::size_t kRoundBytes = kChunksPerRound * kChunkBytes;
 constexpr std::size_t kMinStitchedBytes = kRoundBytes;
 constexpr __mmask64 kWholeChunk = ~__mmask64{0};
@@ -169,6 +172,8 @@ class WholeRuns {
     return at + bytes <= end_;
   }
   std::ptrdiff_t delta() const { return delta_; }
+  /// Where the run that the last successful cover() found ends.
+  std::size_t end() const { return end_; }
   const ChunkedCopyPlan& plan() const { return *plan_; }
 
  private:
@@ -177,32 +182,38 @@ class WholeRuns {
   std::ptrdiff_t delta_ = 0;
 };
 
-/// What decoding and encoding share: four chunks inside one run of whole chunks are one block
-/// copy, `Direction::block` says from where to where.
+/// What decoding and encoding share: rounds inside one run of whole chunks are one block copy,
+/// `Direction::block` says from where to where.
 template <class Direction>
 class ChunkCopy {
  public:
   explicit ChunkCopy(const ChunkedCopyPlan& plan) : runs_(plan) {}
 
-  /// The four chunks from `at` on, copied.
-  RSG_STITCHED_INLINE void round(std::size_t at, __m512i& c0, __m512i& c1, __m512i& c2, __m512i& c3) {
-    auto& direction = static_cast<Direction&>(*this);
-    if (!runs_.cover(at, kRoundBytes)) {
-      c0 = direction(at, kWholeChunk);
-      c1 = direction(at + kChunkBytes, kWholeChunk);
-      c2 = direction(at + 2 * kChunkBytes, kWholeChunk);
-      c3 = direction(at + 3 * kChunkBytes, kWholeChunk);
-      return;
+  /// Folds the rounds from `at` on that lie inside one run of whole chunks and end by `limit`,
+  /// copying them as they go; returns where it stopped (`at` if the round at `at` is not inside a
+  /// run). The loop carries two pointers and nothing else: with the run's bookkeeping inside it,
+  /// the compiler spilled counters to the stack and the round took longer than its multiplies
+  /// (measured on an Intel Xeon, docs/benchmarks/wire.md).
+  RSG_STITCHED_INLINE std::size_t fold_run(std::size_t at, std::size_t limit, __m512i k, __m512i& r0,
+                                           __m512i& r1, __m512i& r2, __m512i& r3) {
+    if (!runs_.cover(at, kRoundBytes)) return at;
+    const std::size_t end = std::min(runs_.end(), limit);
+    auto [from, to] = static_cast<Direction&>(*this).block(at, runs_.delta());
+    for (; at + kRoundBytes <= end; at += kRoundBytes, from += kRoundBytes, to += kRoundBytes) {
+      const __m512i c0 = _mm512_loadu_si512(from);
+      const __m512i c1 = _mm512_loadu_si512(from + kChunkBytes);
+      const __m512i c2 = _mm512_loadu_si512(from + 2 * kChunkBytes);
+      const __m512i c3 = _mm512_loadu_si512(from + 3 * kChunkBytes);
+      _mm512_storeu_si512(to, c0);
+      _mm512_storeu_si512(to + kChunkBytes, c1);
+      _mm512_storeu_si512(to + 2 * kChunkBytes, c2);
+      _mm512_storeu_si512(to + 3 * kChunkBytes, c3);
+      r0 = fold_in(r0, k, c0);
+      r1 = fold_in(r1, k, c1);
+      r2 = fold_in(r2, k, c2);
+      r3 = fold_in(r3, k, c3);
     }
-    const auto [from, to] = direction.block(at, runs_.delta());
-    c0 = _mm512_loadu_si512(from);
-    c1 = _mm512_loadu_si512(from + kChunkBytes);
-    c2 = _mm512_loadu_si512(from + 2 * kChunkBytes);
-    c3 = _mm512_loadu_si512(from + 3 * kChunkBytes);
-    _mm512_storeu_si512(to, c0);
-    _mm512_storeu_si512(to + kChunkBytes, c1);
-    _mm512_storeu_si512(to + 2 * kChunkBytes, c2);
-    _mm512_storeu_si512(to + 3 * kChunkBytes, c3);
+    return at;
   }
 
  protected:
@@ -329,13 +340,17 @@ RSG_STITCHED std::uint32_t stitched_crc32(std::size_t padded_size, std::size_t p
   __m512i r2 = chunks(2 * kChunkBytes, kWholeChunk);
   __m512i r3 = chunks(3 * kChunkBytes, kWholeChunk);
   std::size_t at = kRoundBytes;
-  for (; at + kRoundBytes <= padded_size; at += kRoundBytes) {
-    __m512i c0, c1, c2, c3;
-    chunks.round(at, c0, c1, c2, c3);
-    r0 = fold_in(r0, by_round, c0);
-    r1 = fold_in(r1, by_round, c1);
-    r2 = fold_in(r2, by_round, c2);
-    r3 = fold_in(r3, by_round, c3);
+  while (at + kRoundBytes <= padded_size) {
+    if (const std::size_t next = chunks.fold_run(at, padded_size, by_round, r0, r1, r2, r3); next != at) {
+      at = next;
+      continue;
+    }
+    // A round with a chunk outside the runs: chunk by chunk, each by its pieces.
+    r0 = fold_in(r0, by_round, chunks(at, kWholeChunk));
+    r1 = fold_in(r1, by_round, chunks(at + kChunkBytes, kWholeChunk));
+    r2 = fold_in(r2, by_round, chunks(at + 2 * kChunkBytes, kWholeChunk));
+    r3 = fold_in(r3, by_round, chunks(at + 3 * kChunkBytes, kWholeChunk));
+    at += kRoundBytes;
   }
   __m512i remainder = fold_in(fold_in(fold_in(r0, by_chunk, r1), by_chunk, r2), by_chunk, r3);
   for (; at < padded_size; at += kChunkBytes)

@@ -167,6 +167,34 @@ void BM_DecodeAtPageEdges(benchmark::State& state, const SampleFrame& frame) {
   count_bytes(state, frame.bytes().size());
 }
 
+/// BM_Decode with the frame at a chosen offset from a 64-byte boundary. The stitched kernel loads
+/// 64-byte chunks that end where the frame's CRC-covered bytes end, so they start `padding` bytes
+/// before the frame (43 for a full frame): with the frame 64-byte aligned every load straddles two
+/// cache lines, with the frame at `padding` past a boundary none does. What that costs shows on
+/// Intel, where a straddling 64-byte load takes two load slots (docs/benchmarks/wire.md).
+void BM_DecodeFrameAt(benchmark::State& state, const SampleFrame& frame, std::size_t offset) {
+  constexpr std::size_t kLine = 64;
+  std::vector<std::uint8_t> buffer(frame.bytes().size() + 2 * kLine);
+  const auto address = reinterpret_cast<std::uintptr_t>(buffer.data());
+  std::uint8_t* placed = buffer.data() + (kLine - address % kLine) % kLine + offset % kLine;
+  std::memcpy(placed, frame.bytes().data(), frame.bytes().size());
+  rsg::StateValues values;
+  rsg::FrameCodec codec(rsg::StateValues::layout());
+  for (auto _ : state) {
+    const rsg::DecodeResult result = codec.decode({placed, frame.bytes().size()}, values.storage());
+    if (!result) {
+      state.SkipWithError("the sample frame does not decode");
+      break;
+    }
+    benchmark::DoNotOptimize(values.storage());
+    benchmark::ClobberMemory();
+  }
+  count_bytes(state, frame.bytes().size());
+}
+
+/// Bytes the kernel puts before the frame so that its last chunk ends with the CRC-covered bytes.
+std::size_t head_padding(const SampleFrame& frame) { return (64 - frame.crc_covered().size() % 64) % 64; }
+
 /// The same in two passes, `decode` then `copy_fields`: what stitching the copy into the CRC saves.
 void BM_DecodeThenCopy(benchmark::State& state, const SampleFrame& frame) {
   rsg::StateValues values;
@@ -221,6 +249,9 @@ BENCHMARK_CAPTURE(BM_DecodeValidateOnly, Full, full_frame())->Name("BM_DecodeVal
 BENCHMARK_CAPTURE(BM_Decode, Full, full_frame())->Name("BM_Decode_Full");
 BENCHMARK_CAPTURE(BM_DecodeThenCopy, Full, full_frame())->Name("BM_DecodeThenCopy_Full");
 BENCHMARK_CAPTURE(BM_DecodeAtPageEdges, Full, full_frame())->Name("BM_DecodeAtPageEdges_Full");
+BENCHMARK_CAPTURE(BM_DecodeFrameAt, LineAligned, full_frame(), 0)->Name("BM_DecodeFrameLineAligned_Full");
+BENCHMARK_CAPTURE(BM_DecodeFrameAt, ChunksAligned, full_frame(), head_padding(full_frame()))
+    ->Name("BM_DecodeChunksLineAligned_Full");
 BENCHMARK_CAPTURE(BM_Encode, Full, full_frame())->Name("BM_Encode_Full");
 BENCHMARK_CAPTURE(BM_Deframer, Full, full_frame())->Name("BM_Deframer_Full");
 
