@@ -164,10 +164,10 @@ class DeadlineProbe:
     """rsg_deadline_probe: RobotState arrivals (reader_realtime), deadline misses and status samples
     as JSON lines with CLOCK_MONOTONIC timestamps (`t`, comparable with time.monotonic())."""
 
-    def __init__(self, h, label="deadline_probe", timeout_s=55):
+    def __init__(self, h, label="deadline_probe", timeout_s=55, qos=None):
         self.h, self.label = h, label
         self.process = h.start(label, [h.binary("rsg_deadline_probe"), "--domain", str(h.domain),
-                                       "--timeout", str(timeout_s)])
+                                       "--timeout", str(timeout_s), *(["--qos", qos] if qos else [])])
 
     def events(self, kind=None):
         lines = read_json_lines(self.h.output(self.label))

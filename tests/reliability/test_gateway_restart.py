@@ -2,8 +2,9 @@
 
 The simulator streams at 1 kHz throughout. The gateway is killed (no clean-up of any kind: its
 Fast DDS shared-memory segments stay in /dev/shm) and a new one is started at once, without
-`fastdds shm clean`. A reader_realtime reader (rsg_deadline_probe, timestamps) and a reliable
-logger (rsg_echo --json) keep running across the restart.
+`fastdds shm clean`. A reader_realtime_udp reader (rsg_deadline_probe, timestamps) and a reliable
+logger (rsg_echo --json) keep running across the restart; neither uses data-sharing, which a
+SIGKILLed writer can leave locked (see the probe's comment below).
 
 Pins that
   * the new gateway starts despite the dead one's shared memory, and the readers get samples
@@ -43,7 +44,10 @@ def unbroken_runs(received, record):
 def body(h):
     shm_before_gateway = set(fastdds_shm_segments())
     gateway, stats, port = start_gateway(h, RATE_HZ)
-    probe = DeadlineProbe(h)
+    # Not data-sharing: a SIGKILL while the gateway notifies a data-sharing reader leaves that
+    # reader's notification mutex locked, and Fast DDS 2.9.1 then throws in the reader and in the
+    # next gateway (README, "Operating it safely"). What this test pins is the restart.
+    probe = DeadlineProbe(h, qos="reader_realtime_udp")
     logger = start_logger(h, "logger")
     wait_for_readers(stats, 2)
     wait_reader_matched(h, "logger", "rsg_echo")
