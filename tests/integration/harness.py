@@ -54,6 +54,14 @@ def wait_reader_matched(h, label, tool, writers=1):
     wait_for(lambda: err.exists() and line in err.read_text(errors="replace"), f"{label}'s reader to match")
 
 
+def wait_matched(h, stats, labels, tool):
+    """Both sides of discovery before the robot starts: the gateway's writer counts the readers of
+    the tools started as `labels`, and each of those says its reader matched the writer."""
+    wait_for_stats(stats, lambda s: s["state_readers"] >= len(labels), f"{len(labels)} reader(s) to match the gateway")
+    for label in labels:
+        wait_reader_matched(h, label, tool)
+
+
 def free_udp_port():
     """A port no one is bound to right now (the kernel's pick for port 0)."""
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:

@@ -22,7 +22,7 @@ from pathlib import Path
 from netbed import HOSTS, LineDigests, NetBed, discovery_server_argv, missing_runs
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "integration"))
-from harness import DEFAULT_WAIT_S, check, main, read_json, wait_for, wait_for_stats, wait_reader_matched  # noqa: E402
+from harness import DEFAULT_WAIT_S, check, main, read_json, wait_for, wait_for_stats, wait_matched  # noqa: E402
 
 SCENARIO = sys.argv.pop(1) if len(sys.argv) > 1 and not sys.argv[1].startswith("-") else "stream"
 # Scenario 1's length: the issue asks for 60 s; RSG_NET_SECONDS shortens it for development.
@@ -98,13 +98,6 @@ class Run:
         return read_json(report), time.monotonic() - started
 
 
-def wait_readers(h, stats, labels):
-    """Both sides of discovery: the gateway counts the readers, and each reader says it matched."""
-    wait_for_stats(stats, lambda s: s["state_readers"] >= len(labels), f"{len(labels)} reader(s) to match the gateway")
-    for label in labels:
-        wait_reader_matched(h, label, "rsg_echo")
-
-
 def wait_delivered(label, reader, sent, timeout_s=30):
     """Waits until `reader` printed the last frame sent (delivery is in order)."""
     wait_for(lambda: reader.digests[-1:] == sent[-1:], f"{label} to print the last frame sent", timeout_s)
@@ -143,7 +136,7 @@ def stream(run, h):
                                           "fragments": ("prerouting", f"ip saddr {HOSTS['gw']} ip frag-off & 0x3fff != 0")})
     gateway, stats = run.gateway()
     readers = {host: run.reader(host, f"echo_{host}")[1] for host in ("ops1", "ops2")}
-    wait_readers(h, stats, ["echo_ops1", "echo_ops2"])
+    wait_matched(h, stats, ["echo_ops1", "echo_ops2"], "rsg_echo")
     process, sent, report = run.sim("sim", "--rate", "1000", "--count", count)
     report, seconds = run.finish_sim("sim", process, sent, report, STREAM_SECONDS + 60)
     log(h, f"MEASURED rsg_sim sent {report['sent']} full frames in {seconds:.1f} s ({report['sent'] / seconds:.0f}/s)")
@@ -177,7 +170,7 @@ def views(run, h):
     # sends, once (a reliable view reader is filtered the same way; tests/views covers it).
     _, joints = run.reader("ops1", "echo_joints", "--view", "view_joints", qos="reader_realtime")
     _, everything = run.reader("ops2", "echo_all")
-    wait_readers(h, stats, ["echo_joints", "echo_all"])
+    wait_matched(h, stats, ["echo_joints", "echo_all"], "rsg_echo")
     time.sleep(1.0)  # discovery's last large datagrams (endpoint announcements) are not samples
     read_ops1.reset()
     read_ops2.reset()
@@ -256,7 +249,7 @@ def faults(run, h):
     gateway, stats = run.gateway()
     _, ops1 = run.reader("ops1", "echo_ops1")
     _, ops2 = run.reader("ops2", "echo_ops2")
-    wait_readers(h, stats, ["echo_ops1", "echo_ops2"])
+    wait_matched(h, stats, ["echo_ops1", "echo_ops2"], "rsg_echo")
 
     # a) ops1's cable out for 2 s at 1 kHz: 2000 frames while the writer keeps the last 1000.
     # Static ARP on ops1: a host that lost its carrier re-resolves its peers only at its next ARP
@@ -355,7 +348,7 @@ LOADED_CI_MARGIN = 1.5
 def restart(run, h):
     gateway, stats = run.gateway("gateway1")
     readers = {host: run.reader(host, f"echo_{host}")[1] for host in ("ops1", "ops2")}
-    wait_readers(h, stats, ["echo_ops1", "echo_ops2"])
+    wait_matched(h, stats, ["echo_ops1", "echo_ops2"], "rsg_echo")
     process, sent, report = run.sim("sim", "--rate", "1000", "--duration", "8")
     wait_for(lambda: all(len(r.digests) > 2000 for r in readers.values()), "2 s of samples on both readers")
     check(h.stop("gateway1", gateway) == 0, "the first gateway did not exit 0 on SIGTERM")
@@ -436,7 +429,7 @@ def multicast(run, h):
     for seed, (mode, (gateway_flags, reader_flags)) in enumerate(modes.items()):
         gateway, stats = run.gateway(f"gateway_{mode}", *gateway_flags)
         readers = [run.reader(host, f"echo_{mode}{index}", *reader_flags) for index, host in enumerate(READER_HOSTS)]
-        wait_readers(h, stats, [f"echo_{mode}{index}" for index in range(len(readers))])
+        wait_matched(h, stats, [f"echo_{mode}{index}" for index in range(len(readers))], "rsg_echo")
         time.sleep(1.0)  # discovery's last large datagrams (endpoint announcements) are not samples
         read_gw.reset()
         for read in read_ops.values():
