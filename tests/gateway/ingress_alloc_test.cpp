@@ -188,7 +188,8 @@ class IngressAllocation : public ::testing::Test {
               received - frames.size());
     EXPECT_EQ(final_stats.ingress.published, frames.size() - corrupted);
     EXPECT_EQ(callbacks_, frames.size() - corrupted) << "the callback must see every valid frame, only those";
-    EXPECT_TRUE(final_stats.link_up);
+    // Not link_up: it is down after 10 ms without a frame, and a loaded host can pause this thread
+    // that long after the last burst (it failed so once). link_monitor_test.cpp covers the link.
 
     RobotState sample;
     fdds::SampleInfo info;
