@@ -4,7 +4,7 @@ rsg_echo on the same domain, started first, is never matched and prints nothing.
 
 import sys
 
-from harness import check, main, read_json, read_json_lines, wait_for_stats, free_udp_port
+from harness import check, main, read_json, read_json_lines, wait_for_stats, wait_reader_matched, free_udp_port
 
 COUNT = 200
 RATE = "200"
@@ -23,6 +23,7 @@ def body(h):
                                      "rsg_secure_reader", "--count", str(COUNT), "--timeout", "45"])
     wait_for_stats(stats, lambda s: s["state_readers"] >= 1, "the secure reader to match the gateway's writer",
                    timeout_s=40)
+    wait_reader_matched(h, "secure_echo", "rsg_echo")  # a volatile reader misses what comes before it
 
     record = h.dir / "sim.record.jsonl"
     status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", RATE, "--count", str(COUNT),

@@ -10,7 +10,8 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
-from harness import check, free_udp_port, main, read_json, read_json_lines, wait_for, wait_for_stats  # noqa: E402
+from harness import (check, free_udp_port, main, read_json, read_json_lines, wait_for, wait_for_stats,  # noqa: E402
+                     wait_reader_matched)
 
 COUNT = 200
 RATE = "200"
@@ -40,6 +41,7 @@ def run_gateway(h, namespace):
     wait_for_stats(stats, lambda s: s["state_readers"] >= 3, "both ROS-typed readers to match the state writer")
     for reader in ("_default", "_sensor"):
         wait_for(lambda: "matched" in (h.dir / f"{label}{reader}.err").read_text(), f"{label}{reader} to match")
+    wait_reader_matched(h, label + "_view", "rsg_echo")  # it must see every pose: matched before the first
 
     record = h.dir / f"{label}.sim.jsonl"
     sim = h.run(label + "_sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", RATE, "--count",
