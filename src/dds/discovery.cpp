@@ -109,6 +109,15 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
         eprosima::fastrtps::Duration_t(0, 50'000'000);
   }
 
+  if (!options.empty()) {
+    // rsg_participant announces every 0.5 s for late joiners of multicast discovery
+    // (xml_profiles/rsg.xml). Here each announcement is a datagram per server, or per peer port
+    // (60 for a bare HOST), and a client asks its server again every 50 ms until it answers: keep
+    // Fast DDS's period.
+    builtin.discovery_config.leaseDuration_announcementperiod =
+        eprosima::fastrtps::rtps::DiscoverySettings().leaseDuration_announcementperiod;
+  }
+
   const auto& ports = qos.wire_protocol().port;
   for (const std::string& value : options.peers) {
     HostPort peer;

@@ -82,6 +82,34 @@ TEST(Discovery, APeerWithoutPortCoversEveryGatewayParticipantId) {
   EXPECT_EQ(qos.wire_protocol().builtin.discovery_config.discoveryProtocol, DiscoveryProtocol_t::SIMPLE);
 }
 
+// rsg_participant announces every 0.5 s (a late joiner's lost reply, xml_profiles/rsg.xml); with a
+// server or unicast peers every announcement goes to each of them, so those keep Fast DDS's 3 s.
+TEST(Discovery, MulticastAnnouncesEveryHalfSecondServersAndPeersAtFastDdsDefault) {
+  load_profiles(default_profiles_dir());
+  const eprosima::fastrtps::Duration_t half_second(0, 500'000'000);
+  const auto fastdds_default = eprosima::fastrtps::rtps::DiscoverySettings().leaseDuration_announcementperiod;
+  ASSERT_NE(fastdds_default, half_second);
+  for (const char* profile : {"rsg_participant", "rsg_participant_multicast"}) {
+    fdds::DomainParticipantQos qos;
+    ASSERT_EQ(fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(profile, qos),
+              ReturnCode_t::RETCODE_OK);
+    EXPECT_EQ(qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod, half_second)
+        << profile;
+    fdds::DomainParticipantQos multicast = qos;
+    apply_discovery(DiscoveryOptions{}, 0, multicast);
+    EXPECT_EQ(multicast.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod,
+              half_second);
+    fdds::DomainParticipantQos client = qos;
+    apply_discovery(servers({"127.0.0.1:11811"}), 0, client);
+    EXPECT_EQ(client.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod,
+              fastdds_default);
+    fdds::DomainParticipantQos peer = qos;
+    apply_discovery(peers({"127.0.0.1"}), 0, peer);
+    EXPECT_EQ(peer.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod,
+              fastdds_default);
+  }
+}
+
 TEST(Discovery, BadValuesNameThemselves) {
   EXPECT_NE(check_discovery_server("198.18.0.2").find("HOST:PORT"), std::string::npos);
   EXPECT_NE(check_discovery_server("256@h:1").find("0..255"), std::string::npos);
