@@ -141,10 +141,14 @@ def replay_roundtrip(h):
     """record -> replay -> gateway -> rsg_echo --json gives the original stream exactly, and the
     replayed datagrams are byte for byte the ones the first gateway received; --domain replays the
     samples over DDS to the same effect. The frames keep the recording's spacing divided by --speed
-    (1 and 2; a lower bound on the span from the first to the last arrival), and --loop plays the
-    file again, the same frames, right after its end."""
+    (2 and 0.5; a lower bound on the span from the first to the last arrival), and --loop plays the
+    file again, the same frames, the second pass starting one mean gap of the recording (divided by
+    --speed) after the first one's last frame (a lower bound: at least half a mean gap)."""
     count = 1200
-    port, gateway, stats, rec, out = gateway_with_recorder(h)
+    # Small chunks: starting the file over then costs rsg_replay a fraction of a millisecond (unpacking
+    # a default 1 MiB first chunk takes about one mean gap of this stream), so that the gap at the wrap
+    # that --loop's check sees is the one rsg_replay leaves on purpose.
+    port, gateway, stats, rec, out = gateway_with_recorder(h, "--chunk-size", "65536")
     tap_port = free_udp_port()
     tap = UdpRelay(tap_port, forward_to=("127.0.0.1", port))
     tap.start()
@@ -157,6 +161,8 @@ def replay_roundtrip(h):
     check(h.stop("record", rec) == 0, f"rsg_record did not exit 0: {stderr_of(h, 'record')}")
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
     sent = read_json_lines(record)
+    recorded = node_check(h, out, "--frames", record)
+    check(recorded["states"] == count, f"read {recorded}")
 
     # Raw: replay -> tap -> second gateway -> rsg_echo --json.
     port2 = free_udp_port()
@@ -187,10 +193,11 @@ def replay_roundtrip(h):
     print(f"[{h.name}] recorded over {span_s:.3f} s, replayed at --speed 2 in {took:.3f} s", flush=True)
     check(took >= 0.8 * span_s / 2, f"--speed 2 replayed {span_s:.3f} s of frames in {took:.3f} s")
 
-    # --loop at the original timing, until SIGINT: a second pass of the same frames follows the first.
+    # --loop at half speed, until SIGINT: a second pass of the same frames follows the first.
+    speed = 0.5
     receiver = timed_receiver()
     looping = h.start("replay_loop", [h.binary("rsg_replay"), str(out), "--to",
-                                      f"127.0.0.1:{receiver.getsockname()[1]}", "--loop"])
+                                      f"127.0.0.1:{receiver.getsockname()[1]}", "--loop", "--speed", str(speed)])
     again = count // 4
     looped = receive_timed(receiver, count + again, timeout_s=30, quiet_s=None)
     looping.send_signal(signal.SIGINT)
@@ -201,8 +208,23 @@ def replay_roundtrip(h):
     check(frames[:count] == tap.datagrams, "the first pass of --loop differs from the frames the gateway received")
     check(frames[count:] == tap.datagrams[:again], "the second pass of --loop does not play the file from its start")
     took = looped[count - 1][0] - looped[0][0]
-    print(f"[{h.name}] the first pass of --loop took {took:.3f} s", flush=True)
-    check(took >= 0.8 * span_s, f"rsg_replay played {span_s:.3f} s of frames in {took:.3f} s at their original timing")
+    print(f"[{h.name}] the first pass of --loop at --speed {speed} took {took:.3f} s", flush=True)
+    check(took >= 0.8 * span_s / speed,
+          f"rsg_replay played {span_s:.3f} s of frames in {took:.3f} s at --speed {speed}")
+    # The second pass is due one mean gap (divided by --speed) after the first pass's last frame was due,
+    # and nothing is sent before it is due; the first frame goes out at once. So from the first arrival
+    # to the first of the second pass is at least the file's span and one mean gap, divided by --speed
+    # (half a mean gap here: slack for the first send), whatever the host's load. A second pass started
+    # right after the last frame falls short unless that frame went out late by more than that.
+    file_span_s = recorded["publish_span_ns"] / 1e9
+    mean_gap_s = file_span_s / (count - 1)
+    second_pass_s = looped[count][0] - looped[0][0]
+    print(f"[{h.name}] the file spans {file_span_s:.4f} s (mean gap {mean_gap_s * 1e3:.3f} ms); --loop's second "
+          f"pass started {second_pass_s:.4f} s after the first, "
+          f"{(looped[count][0] - looped[count - 1][0]) * 1e3:.3f} ms after the first pass's last frame", flush=True)
+    check(second_pass_s >= (file_span_s + mean_gap_s / 2) / speed,
+          f"--loop --speed {speed} started the second pass {second_pass_s:.4f} s after the first; the file spans "
+          f"{file_span_s:.4f} s with a mean gap of {mean_gap_s * 1e3:.3f} ms")
 
     # DDS: replay --domain -> rsg_echo --json.
     echo2 = h.start("echo2", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "dds_replayed", "--json",
