@@ -160,4 +160,10 @@ if (framesPath) {
   }
 }
 
-console.log(JSON.stringify({ ...summary, messages: messages.length, states: states.length, statuses: statuses.length }));
+// The latest publish time of a state after the first one's: the span rsg_replay plays a pass over.
+const publishSpan = states.reduce((span, message) => {
+  const offset = message.publishTime - states[0].publishTime;
+  return offset > span ? offset : span;
+}, 0n);
+console.log(JSON.stringify({ ...summary, messages: messages.length, states: states.length, statuses: statuses.length,
+                             publish_span_ns: Number(publishSpan) }));

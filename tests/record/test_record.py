@@ -141,10 +141,14 @@ def replay_roundtrip(h):
     """record -> replay -> gateway -> rsg_echo --json gives the original stream exactly, and the
     replayed datagrams are byte for byte the ones the first gateway received; --domain replays the
     samples over DDS to the same effect. The frames keep the recording's spacing divided by --speed
-    (1 and 2; a lower bound on the span from the first to the last arrival), and --loop plays the
-    file again, the same frames, right after its end."""
+    (2 and 0.5; a lower bound on the span from the first to the last arrival), and --loop plays the
+    file again, the same frames, the second pass starting one mean gap of the recording (divided by
+    --speed) after the first one's last frame (a lower bound: at least half a mean gap)."""
     count = 1200
-    port, gateway, stats, rec, out = gateway_with_recorder(h)
+    # Small chunks: starting the file over then costs rsg_replay a fraction of a millisecond (unpacking
+    # a default 1 MiB first chunk takes about one mean gap of this stream), so that the gap at the wrap
+    # that --loop's check sees is the one rsg_replay leaves on purpose.
+    port, gateway, stats, rec, out = gateway_with_recorder(h, "--chunk-size", "65536")
     tap_port = free_udp_port()
     tap = UdpRelay(tap_port, forward_to=("127.0.0.1", port))
     tap.start()
@@ -157,6 +161,8 @@ def replay_roundtrip(h):
     check(h.stop("record", rec) == 0, f"rsg_record did not exit 0: {stderr_of(h, 'record')}")
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
     sent = read_json_lines(record)
+    recorded = node_check(h, out, "--frames", record)
+    check(recorded["states"] == count, f"read {recorded}")
 
     # Raw: replay -> tap -> second gateway -> rsg_echo --json.
     port2 = free_udp_port()
@@ -187,10 +193,11 @@ def replay_roundtrip(h):
     print(f"[{h.name}] recorded over {span_s:.3f} s, replayed at --speed 2 in {took:.3f} s", flush=True)
     check(took >= 0.8 * span_s / 2, f"--speed 2 replayed {span_s:.3f} s of frames in {took:.3f} s")
 
-    # --loop at the original timing, until SIGINT: a second pass of the same frames follows the first.
+    # --loop at half speed, until SIGINT: a second pass of the same frames follows the first.
+    speed = 0.5
     receiver = timed_receiver()
     looping = h.start("replay_loop", [h.binary("rsg_replay"), str(out), "--to",
-                                      f"127.0.0.1:{receiver.getsockname()[1]}", "--loop"])
+                                      f"127.0.0.1:{receiver.getsockname()[1]}", "--loop", "--speed", str(speed)])
     again = count // 4
     looped = receive_timed(receiver, count + again, timeout_s=30, quiet_s=None)
     looping.send_signal(signal.SIGINT)
@@ -201,8 +208,23 @@ def replay_roundtrip(h):
     check(frames[:count] == tap.datagrams, "the first pass of --loop differs from the frames the gateway received")
     check(frames[count:] == tap.datagrams[:again], "the second pass of --loop does not play the file from its start")
     took = looped[count - 1][0] - looped[0][0]
-    print(f"[{h.name}] the first pass of --loop took {took:.3f} s", flush=True)
-    check(took >= 0.8 * span_s, f"rsg_replay played {span_s:.3f} s of frames in {took:.3f} s at their original timing")
+    print(f"[{h.name}] the first pass of --loop at --speed {speed} took {took:.3f} s", flush=True)
+    check(took >= 0.8 * span_s / speed,
+          f"rsg_replay played {span_s:.3f} s of frames in {took:.3f} s at --speed {speed}")
+    # The second pass is due one mean gap (divided by --speed) after the first pass's last frame was due,
+    # and nothing is sent before it is due; the first frame goes out at once. So from the first arrival
+    # to the first of the second pass is at least the file's span and one mean gap, divided by --speed
+    # (half a mean gap here: slack for the first send), whatever the host's load. A second pass started
+    # right after the last frame falls short unless that frame went out late by more than that.
+    file_span_s = recorded["publish_span_ns"] / 1e9
+    mean_gap_s = file_span_s / (count - 1)
+    second_pass_s = looped[count][0] - looped[0][0]
+    print(f"[{h.name}] the file spans {file_span_s:.4f} s (mean gap {mean_gap_s * 1e3:.3f} ms); --loop's second "
+          f"pass started {second_pass_s:.4f} s after the first, "
+          f"{(looped[count][0] - looped[count - 1][0]) * 1e3:.3f} ms after the first pass's last frame", flush=True)
+    check(second_pass_s >= (file_span_s + mean_gap_s / 2) / speed,
+          f"--loop --speed {speed} started the second pass {second_pass_s:.4f} s after the first; the file spans "
+          f"{file_span_s:.4f} s with a mean gap of {mean_gap_s * 1e3:.3f} ms")
 
     # DDS: replay --domain -> rsg_echo --json.
     echo2 = h.start("echo2", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "dds_replayed", "--json",
@@ -276,33 +298,45 @@ def ros2_profile(h):
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
 
 
+def gateway_with_traced_recorder(h, inject, *record_flags):
+    """A gateway on a free port and rsg_record under strace (started as "record"), matched to its
+    writers: strace logs the recorder's fdatasync calls to fdatasync.trace and injects `inject`
+    into them (-y names each descriptor's file; --seccomp-bpf stops the recorder for fdatasync only)."""
+    strace = shutil.which("strace")
+    check(strace is not None, "strace is not installed: run `make deps`")
+    port = free_udp_port()
+    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000")
+    out = h.dir / "run.mcap"
+    traced = h.start("record", [strace, "-f", "-y", "--seccomp-bpf", "-e", "trace=fdatasync",
+                                "-e", f"inject=fdatasync:{inject}", "-o", str(h.dir / "fdatasync.trace"),
+                                h.binary("rsg_record"), "--domain", str(h.domain), "--out", str(out), *record_flags])
+    wait_matched(h, stats, ["record"], "rsg_record")
+    return port, gateway, stats, traced, out
+
+
+def strace_child(traced):
+    """The pid of the one process strace (started as `traced`) runs."""
+    children = Path(f"/proc/{traced.pid}/task/{traced.pid}/children").read_text().split()
+    check(len(children) == 1, f"strace has children {children}")
+    return int(children[0])
+
+
 def chunk_size_fsync(h):
     """--chunk-size 65536 finishes a chunk as soon as its records reach 64 KiB (the reference reader
     finds no larger one, and as many as the recorder reports); --fsync calls fdatasync on the file
     after every finished chunk and once at the end (strace, Debian's, counts the calls). strace also
     makes every fdatasync take 50 ms, a slow disk: the recorder falls seconds behind the stream and
     still records every frame. (On SIGTERM it writes what its reader had received before closing;
-    this test does not tell that apart, since its last batch usually holds the rest already.)"""
-    strace = shutil.which("strace")
-    check(strace is not None, "strace is not installed: run `make deps`")
+    this test does not tell that apart, since its last batch usually holds the rest already:
+    drain_on_sigterm does.)"""
     chunk = 65536
-    port = free_udp_port()
-    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000")
-    out = h.dir / "run.mcap"
-    trace = h.dir / "fdatasync.trace"
-    # -y names each descriptor's file; --seccomp-bpf stops the recorder for fdatasync calls only.
-    traced = h.start("record", [strace, "-f", "-y", "--seccomp-bpf", "-e", "trace=fdatasync",
-                                "-e", "inject=fdatasync:delay_enter=50000", "-o", str(trace),
-                                h.binary("rsg_record"), "--domain", str(h.domain), "--out", str(out),
-                                "--chunk-size", str(chunk), "--fsync"])
-    wait_matched(h, stats, ["record"], "rsg_record")
+    port, gateway, stats, traced, out = gateway_with_traced_recorder(h, "delay_enter=50000", "--chunk-size", str(chunk),
+                                                                     "--fsync")
     record = run_sim(h, port, 2000, 1000)  # every field in every frame: about 2 KB a message
     wait_for_stats(stats, lambda s: s["frames_published"] >= 2000, "the gateway to publish every frame")
     time.sleep(0.5)  # the last samples reach the recorder's DDS reader (not its file: that is seconds behind)
     # SIGTERM to rsg_record itself (strace's child), as an operator would; strace then exits with it.
-    children = Path(f"/proc/{traced.pid}/task/{traced.pid}/children").read_text().split()
-    check(len(children) == 1, f"strace has children {children}")
-    os.kill(int(children[0]), signal.SIGTERM)
+    os.kill(strace_child(traced), signal.SIGTERM)
     check(h.wait("record", traced, 30) == 0, f"rsg_record did not exit 0 on SIGTERM: {stderr_of(h, 'record')}")
     err = stderr_of(h, "record")
     seen = node_check(h, out, "--frames", record)
@@ -312,7 +346,7 @@ def chunk_size_fsync(h):
     check(seen["chunks"] >= 2000 * 1500 // (chunk + 4096), f"only {seen['chunks']} chunks of at most {chunk} bytes")
     check(f" in {seen['chunks']} chunks, " in err, f"the recorder reports other chunks than the file has: {err}")
     # A call another thread interrupts shows as "fdatasync(3</path> <unfinished ...>", then "<... fdatasync resumed>".
-    lines = trace.read_text().splitlines()
+    lines = (h.dir / "fdatasync.trace").read_text().splitlines()
     syncs = [line for line in lines if "fdatasync(" in line and f"{out}>" in line]
     failed = [line for line in lines if "fdatasync" in line and "= -1" in line]
     check(len(syncs) == seen["chunks"] + 1 and not failed,
@@ -322,8 +356,48 @@ def chunk_size_fsync(h):
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
 
 
+def drain_on_sigterm(h):
+    """On SIGTERM rsg_record writes what its DDS reader had already received before it closes the
+    file. strace holds the recorder's main thread in its first fdatasync (--fsync: the chunk holding
+    the gateway's first status samples, finished a second later) for 20 s, a stalled disk; meanwhile
+    rsg_sim sends 400 frames, the reliable reader receives them (DDS's own threads run on) and the
+    recorder gets SIGTERM. Its last take was before the stall, so only the drain at the stop puts
+    those frames in the file. The test checks (in /proc) that the main thread stayed in that stop,
+    not running once, from before the first frame until after the stop request."""
+    count = 400
+    # when=1: only the first fdatasync stalls; the ones that finish the file at the stop are quick.
+    port, gateway, stats, traced, out = gateway_with_traced_recorder(h, "delay_enter=20000000:when=1", "--fsync")
+    pid = strace_child(traced)
+    main_thread = Path(f"/proc/{pid}/task/{pid}")
+
+    def stalled():
+        """The main thread's state ('t': stopped by strace) and how often it has been switched out."""
+        # The state follows the command name in parentheses (which may hold spaces).
+        state = (main_thread / "stat").read_text().rsplit(")", 1)[1].split()[0]
+        switches = sum(int(line.split()[1]) for line in (main_thread / "status").read_text().splitlines()
+                       if line.startswith(("voluntary_ctxt_switches:", "nonvoluntary_ctxt_switches:")))
+        return state == "t", switches
+
+    wait_for(lambda: stalled()[0], "the recorder to stall in its first fdatasync")
+    before = stalled()
+    record = run_sim(h, port, count, 2000)
+    wait_for_stats(stats, lambda s: s["frames_published"] >= count, "the gateway to publish every frame")
+    time.sleep(1.0)  # the frames reach the recorder's reliable reader (same host: milliseconds)
+    os.kill(pid, signal.SIGTERM)
+    time.sleep(0.5)  # StopOnSignal's thread takes the signal at once and asks the main thread to stop
+    check(stalled() == before, "the recorder's main thread ran between the first frame and SIGTERM (a host "
+          f"too slow for the 20 s stall?), so this run cannot tell the drain apart: {before} then {stalled()}")
+    check(h.wait("record", traced, 60) == 0, f"rsg_record did not exit 0 on SIGTERM: {stderr_of(h, 'record')}")
+    err = stderr_of(h, "record")
+    print(f"[{h.name}] {err.strip()}", flush=True)
+    seen = node_check(h, out, "--frames", record)
+    check(seen["states"] == count, f"the file holds {seen['states']} of the {count} frames the reader had at SIGTERM")
+    check(f"received {count} states" in err, f"the recorder's summary: {err}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
 CASES = {f.__name__: f for f in (reference_reader, sigkill, write_errors, replay_roundtrip, split_and_view, duration,
-                                 ros2_profile, chunk_size_fsync)}
+                                 ros2_profile, chunk_size_fsync, drain_on_sigterm)}
 
 if __name__ == "__main__":
     sys.exit(main(f"record_{CASE}", CASES[CASE]))

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <iostream>
@@ -114,8 +115,10 @@ class DdsOutput final : public Output {
   fdds::DataWriter* writer_;  // owned by participant_
 };
 
-/// Sends each RobotState message when it is due: publish times relative to the first message,
-/// divided by the speed, on the steady clock.
+/// Sends each RobotState message when it is due: publish times relative to the first message of the
+/// pass, divided by the speed, on the steady clock. With --loop each pass starts one mean gap of the
+/// pass before it after that pass's last sample (as `rsg_sim --replay --loop` does), so that a looped
+/// recording keeps its rate across the wrap.
 class Player final : public rsg::mcap::RecordVisitor {
  public:
   Player(Output& output, double speed, const std::atomic<bool>& stop)
@@ -136,27 +139,43 @@ class Player final : public rsg::mcap::RecordVisitor {
     }
     if (!first_time_) {
       first_time_ = message.publish_time;
-      start_ = Clock::now();
+      if (!pass_start_) pass_start_ = Clock::now();
     }
-    const double offset_ns =
-        static_cast<double>(static_cast<std::int64_t>(message.publish_time - *first_time_)) / speed_;
-    wait_until(start_ + std::chrono::nanoseconds(static_cast<std::int64_t>(std::max(0.0, offset_ns))));
+    // A publish time going back is sent at once.
+    pass_span_ns_ = std::max(
+        pass_span_ns_, static_cast<double>(static_cast<std::int64_t>(message.publish_time - *first_time_)));
+    wait_until(*pass_start_ + scaled(pass_span_ns_));
     if (stop_) return false;
     if (!output_.send(sample_)) {
       failed = true;
       return false;
     }
     ++sent;
+    ++in_pass_;
     return true;
   }
 
-  /// Starts the timeline again (for --loop).
-  void restart() { first_time_.reset(); }
+  /// Starts the timeline again (for --loop), one mean gap of the pass just played after its last sample.
+  void restart() {
+    if (in_pass_ > 0) {
+      // One sample has no gap to take the mean of: 1 ms, as rsg_sim --replay takes for one datagram.
+      const double gap_ns = in_pass_ > 1 ? pass_span_ns_ / static_cast<double>(in_pass_ - 1) : 1e6;
+      *pass_start_ += scaled(pass_span_ns_ + gap_ns);
+    }
+    first_time_.reset();
+    pass_span_ns_ = 0;
+    in_pass_ = 0;
+  }
 
   std::uint64_t sent = 0, undecodable = 0;
   bool failed = false;
 
  private:
+  Clock::duration scaled(double recorded_ns) const {
+    return std::chrono::duration_cast<Clock::duration>(
+        std::chrono::nanoseconds(std::llround(recorded_ns / speed_)));
+  }
+
   void wait_until(Clock::time_point due) const {
     while (!stop_) {
       const auto left = due - Clock::now();
@@ -171,8 +190,10 @@ class Player final : public rsg::mcap::RecordVisitor {
   std::unordered_set<std::uint16_t> state_schemas_, state_channels_;
   rsg::record::CdrSerializer serializer_;
   rsg::RobotState sample_;
-  std::optional<std::uint64_t> first_time_;
-  Clock::time_point start_;
+  std::optional<std::uint64_t> first_time_;      // publish time of the pass's first sample
+  std::optional<Clock::time_point> pass_start_;  // when the pass's first sample is due
+  double pass_span_ns_ = 0;                      // latest publish time of the pass so far, from its first
+  std::uint64_t in_pass_ = 0;                    // samples sent in this pass
 };
 
 void add_options(CLI::App& app, Options& options) {
@@ -195,7 +216,9 @@ void add_options(CLI::App& app, Options& options) {
   app.add_option("--speed", options.speed, "Play this many times faster than recorded")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_flag("--loop", options.loop, "Play the file again and again until SIGINT/SIGTERM");
+  app.add_flag("--loop", options.loop,
+               "Play the file again and again until SIGINT/SIGTERM, each pass one mean gap between samples "
+               "after the one before");
 }
 
 void wait_for_readers(fdds::DataWriter& writer, int readers, const std::atomic<bool>& stop) {
