@@ -231,6 +231,7 @@ void Ingress::fill(GatewayStats& stats) const {
   writer_->get_publication_matched_status(matched);
   stats.state_readers = static_cast<std::uint32_t>(matched.current_count);
   stats.source = source_.size() ? source_.to_string() : std::string();
+  stats.standard_dropped = standard_topics_ ? standard_topics_->dropped() : 0;
 }
 
 void Ingress::log_rejections() {

@@ -35,6 +35,7 @@ std::string to_json(const GatewayStats& stats) {
       {"egress_frames_sent", stats.egress.frames_sent},
       {"egress_unencodable", stats.egress.unencodable},
       {"egress_send_failed", stats.egress.send_failed},
+      {"standard_dropped", stats.standard_dropped},
   };
   return json.dump();
 }
@@ -63,6 +64,7 @@ std::string summary_line(const GatewayStats& stats) {
   if (out.samples || out.unencodable)
     line += fmt::format("; egress samples {} sent {} unencodable {} send_failed {}", out.samples,
                         out.frames_sent, out.unencodable, out.send_failed);
+  if (stats.standard_dropped) line += fmt::format("; standard_dropped {}", stats.standard_dropped);
   return line;
 }
 

@@ -43,6 +43,9 @@ struct GatewayStats {
   std::uint32_t egress_writers = 0;  ///< writers matched by the egress reader
   SequenceTracker::Counts sequence;
   EgressCounters egress;
+  /// Snapshots for the ROS 2 standard topics dropped because their publishing thread was a whole
+  /// ring behind (Ros2StandardTopics::dropped()); 0 when those topics are off.
+  std::uint64_t standard_dropped = 0;
   double rate_hz = 0;  ///< valid frames per second over the last status period
   bool link_up = false;
   std::string source;  ///< "HOST:PORT" of the last valid frame, empty before the first

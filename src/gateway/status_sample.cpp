@@ -41,6 +41,7 @@ void to_status_sample(const GatewayStats& stats, GatewayStatus& sample) {
   sample.egress_frames_sent(stats.egress.frames_sent);
   sample.egress_unencodable(stats.egress.unencodable);
   sample.egress_send_failed(stats.egress.send_failed);
+  sample.standard_dropped(stats.standard_dropped);
 }
 
 GatewayStats from_status_sample(const GatewayStatus& sample) {
@@ -63,6 +64,7 @@ GatewayStats from_status_sample(const GatewayStatus& sample) {
                   .frames_sent = sample.egress_frames_sent(),
                   .unencodable = sample.egress_unencodable(),
                   .send_failed = sample.egress_send_failed()};
+  stats.standard_dropped = sample.standard_dropped();
   return stats;
 }
 

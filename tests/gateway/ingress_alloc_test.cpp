@@ -188,6 +188,9 @@ class IngressAllocation : public ::testing::Test {
               received - frames.size());
     EXPECT_EQ(final_stats.ingress.published, frames.size() - corrupted);
     EXPECT_EQ(callbacks_, frames.size() - corrupted) << "the callback must see every valid frame, only those";
+    if (!standard_topics_) {
+      EXPECT_EQ(final_stats.standard_dropped, 0U) << "no standard topics, nothing to drop";
+    }
     // Not link_up: it is down after 10 ms without a frame, and a loaded host can pause this thread
     // that long after the last burst (it failed so once). link_monitor_test.cpp covers the link.
 
@@ -286,6 +289,10 @@ TEST_F(IngressAllocation, WithTheRos2StandardTopicsOnNothingAllocates) {
            for (int i = 0; i < 2000 && topics->written()[0] + topics->dropped() < valid; ++i)
              std::this_thread::sleep_for(10ms);
            EXPECT_EQ(topics->written()[0] + topics->dropped(), valid);
+           // Only the ingress thread drops, and it is done: the status carries the final count.
+           GatewayStats now;
+           ingress.fill(now);
+           EXPECT_EQ(now.standard_dropped, topics->dropped());
            EXPECT_GT(topics->written()[0], 0U);
            EXPECT_GT(topics->written()[1], 0U);
            EXPECT_GT(topics->written()[2], 0U);

@@ -21,6 +21,7 @@ GatewayStats distinct_stats() {
   stats.state_readers = 13;
   stats.egress_writers = 14;
   stats.egress = {.samples = 9, .frames_sent = 10, .unencodable = 11, .send_failed = 12};
+  stats.standard_dropped = 15;
   return stats;
 }
 
@@ -59,6 +60,7 @@ TEST(StatusSample, CountersAndLinkStateAreCopied) {
   EXPECT_EQ(sample.egress_frames_sent(), 10U);
   EXPECT_EQ(sample.egress_unencodable(), 11U);
   EXPECT_EQ(sample.egress_send_failed(), 12U);
+  EXPECT_EQ(sample.standard_dropped(), 15U);
 }
 
 TEST(StatusSample, ReadsBackWhatItWrote) {
@@ -84,6 +86,7 @@ TEST(StatsJson, UsesTheStatusNamesAndCategoryNames) {
   EXPECT_EQ(json["invalid"]["bad_value"], 106);
   EXPECT_EQ(json["invalid"].size(), kErrorCategoryCount);
   EXPECT_EQ(json["source"], "192.0.2.1:40000");
+  EXPECT_EQ(json["standard_dropped"], 15);
 }
 
 TEST(StatsSummary, NamesOnlyTheCategoriesThatOccurred) {
@@ -92,6 +95,9 @@ TEST(StatsSummary, NamesOnlyTheCategoriesThatOccurred) {
   counts[invalid_index(ErrorCategory::kTruncated)] = 1;
   EXPECT_EQ(format_invalid(counts), "truncated=1 bad_crc=3");
   EXPECT_NE(summary_line(distinct_stats()).find("link up"), std::string::npos);
+  EXPECT_NE(summary_line(distinct_stats()).find("; standard_dropped 15"), std::string::npos);
+  EXPECT_EQ(summary_line(GatewayStats{}).find("standard_dropped"), std::string::npos)
+      << "the topics are off, or nothing was dropped: not worth a word";
 }
 
 }  // namespace

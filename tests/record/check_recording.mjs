@@ -7,6 +7,8 @@
 //
 //   node check_recording.mjs FILE.mcap --frames sim.jsonl [--idl idl/RobotState.idl] [--profile ros2]
 //        [--truncated]   a killed recorder's file: no summary; read it as a stream, record by record
+//        [--unindexed]   a file finished without a summary (no room was left for one): read it as a
+//                        stream, and it must end with a footer
 //        [--prefix]      the file may hold only the first frames (a recorder stopped by an error)
 //        [--skip N]      the file's first state is frame N (the second and later files of --split-size)
 //        [--groups G]    only frames carrying all groups of the bit mask G (a recorder on a view)
@@ -31,6 +33,7 @@ const framesPath = option("--frames");
 const idlPath = option("--idl");
 const profile = option("--profile") ?? "";
 const truncated = flag("--truncated");
+const unindexed = flag("--unindexed");
 
 await zstd.isLoaded;
 const decompressHandlers = { zstd: (buffer, size) => new Uint8Array(zstd.decompress(buffer, Number(size))) };
@@ -43,7 +46,7 @@ const schemas = new Map();
 const channels = new Map();
 const messages = [];
 let summary = {};
-if (truncated) {
+if (truncated || unindexed) {
   const reader = new McapStreamReader({ decompressHandlers, validateCrcs: true });
   reader.append(readFileSync(file));
   let footer = false;
@@ -53,7 +56,8 @@ if (truncated) {
     else if (record.type === "Message") messages.push(record);
     else if (record.type === "Footer") footer = true;
   }
-  check(!footer, "the file has a footer: it was finished, not cut off");
+  if (unindexed) check(footer, "the file has no footer: it was cut off, not finished");
+  else check(!footer, "the file has a footer: it was finished, not cut off");
   summary = { leftover_bytes: reader.bytesRemaining() };
 } else {
   const handle = await open(file, "r");

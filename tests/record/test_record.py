@@ -132,7 +132,11 @@ def write_errors(h):
     err = stderr_of(h, "record")
     check("File too large" in err and "the file was finished" in err, err)
     check(out.stat().st_size <= limit, "the file outgrew the limit")
-    seen = node_check(h, out, "--frames", record, "--prefix")
+    # Whether the summary fits between the last whole chunk and the limit depends on a few hundred
+    # bytes (the schemas' size moves every chunk boundary): without it the file ends with a footer
+    # alone, which the reference reader reads as a stream.
+    unindexed = ["--unindexed"] if "finished without an index" in err else []
+    seen = node_check(h, out, "--frames", record, "--prefix", *unindexed)
     check(seen["states"] > 100, f"read {seen}")
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
 

@@ -33,7 +33,8 @@ std::string status_json(const rsg_msgs_msg_dds__GatewayStatus_& status) {
          ",\"frames_received\":" + std::to_string(status.frames_received) +
          ",\"frames_published\":" + std::to_string(status.frames_published) +
          ",\"invalid_bad_crc\":" + std::to_string(status.invalid_bad_crc) +
-         ",\"state_readers\":" + std::to_string(status.state_readers) + "}";
+         ",\"state_readers\":" + std::to_string(status.state_readers) +
+         ",\"standard_dropped\":" + std::to_string(status.standard_dropped) + "}";
 }
 
 using rsg::interop::Entity;

@@ -74,6 +74,9 @@ def run_gateway(h, namespace):
     check(len(statuses) == 2, f"status reader printed {len(statuses)} samples")
     check(statuses[-1]["frames_received"] <= final["frames_received"], "status counters ahead of the stats file")
     check(statuses[-1]["source"] in ("", final["source"]), f"status source {statuses[-1]['source']!r}")
+    # The last member, read through the .msg's layout; no standard topics here, so nothing dropped.
+    check(statuses[-1]["standard_dropped"] == 0 and final["standard_dropped"] == 0,
+          f"standard_dropped {statuses[-1]['standard_dropped']} / {final['standard_dropped']} without standard topics")
 
 
 def body(h):

@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
-from harness import check, free_udp_port, main, read_json_lines, wait_for, wait_for_stats  # noqa: E402
+from harness import check, free_udp_port, main, read_json, read_json_lines, wait_for, wait_for_stats  # noqa: E402
 
 FRAMES = 2000  # 2 s at 1 kHz
 IDLE_S = "8"   # a reader stops this long after the last message
@@ -221,6 +221,9 @@ def plain_dds_run(h):
             time.sleep(0.002)  # a robot's pace; the rates go by the frames' time (1 ms apart), not by this
     got = collect(h, readers)
     check(h.stop("plain", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+    # 40 frames leave at most 40 snapshots, fewer than the ring holds: none can have been dropped.
+    dropped = read_json(stats)["standard_dropped"]
+    check(dropped == 0, f"standard_dropped {dropped} for fewer snapshots than the ring holds")
 
     joints = got["joint_states"]
     check(len(joints) == len(with_joints), f"{len(joints)} JointStates for {len(with_joints)} frames with q")
