@@ -24,10 +24,10 @@
 #         RSG_BENCH_SCALE_SECONDS   measuring window per point (default 8)
 #         RSG_BENCH_SCALE_SERIES    scale.py --series (default robots,readers; add readers_multicast
 #                                   for M readers of rsg_participant_multicast: four more points)
-#   late_join  a reader started next to a running gateway, 40 times, with rsg's participant profile
+#   late_join  a reader started next to a running gateway, 100 times, with rsg's participant profile
 #         and with Fast DDS's default announcement period (late_join.py): time to the first sample,
-#         bench/late_join/ (late_join.json, late_join.md). About 1 minute.
-#         RSG_BENCH_LATE_JOIN_STARTS   starts per profile (default 40)
+#         bench/late_join/ (late_join.json, late_join.md). About 1.5 minutes.
+#         RSG_BENCH_LATE_JOIN_STARTS   starts per profile (default 100)
 #
 # A suite is a function run_<suite> that writes its results under $out and a function
 # report_<suite> that prints them, plus its name in SUITES.
@@ -135,7 +135,7 @@ run_scale() {
 report_scale() { cat "$out/scale/scale.md"; }
 
 run_late_join() {
-  python3 "$here/late_join.py" --bin "$build/bin" --out "$out/late_join" --starts "${RSG_BENCH_LATE_JOIN_STARTS:-40}" >/dev/null
+  python3 "$here/late_join.py" --bin "$build/bin" --out "$out/late_join" --starts "${RSG_BENCH_LATE_JOIN_STARTS:-100}" >/dev/null
 }
 report_late_join() { cat "$out/late_join/late_join.md"; }
 
