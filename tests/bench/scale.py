@@ -21,8 +21,9 @@ every reader (and the worst reader's p99 on its own).
 Per point, over a window after a warm-up: gateway CPU (utime+stime from /proc, % of one core;
 total and per robot), gateway RSS, whole-host CPU (/proc/stat, cores busy), each gateway's
 published rate, and the time from launching the gateways (robots already streaming) to the
-first sample at every robot's first-sample probe (rsg_echo --count 1). With --discovery-server
-every participant is a client of `fastdds discovery` on gw.
+first sample at every robot's first-sample probe (the first line of rsg_echo --json --count 1,
+started with the gateways). With --discovery-server every participant is a client of
+`fastdds discovery` on gw.
 
 Readers use rsg_echo's table-mode QoS (reader_realtime: best effort), so the gateway serves them
 as it serves a monitoring consumer; they print nothing, so what "all rsg processes" adds per reader
@@ -50,6 +51,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -129,12 +131,22 @@ class Point:
                                                         "--stats-file", stats[-1], *self.discovery]))
         probes = [self.start("ops1", f"probe{k}", [b / "rsg_echo", "--domain", self.domain, "--partition",
                                                    f"robot{k}", "--json", "--count", 1, "--timeout", 30,
-                                                   *self.discovery], stdout=subprocess.DEVNULL)
+                                                   *self.discovery], stdout=subprocess.PIPE)
                   for k in range(self.robots)]
-        first = []
-        for probe in probes:
-            status = probe.wait(timeout=40)
-            first.append(time.monotonic() - launched if status == 0 else float("nan"))
+        # The first sample is the probe's first line, not its exit: a Fast DDS process sleeps 100 ms
+        # while it shuts down (DomainParticipantFactory's destructor), and 16 of them shut down at once.
+        first = [float("nan")] * self.robots
+
+        def first_line(k):
+            if probes[k].stdout.readline():
+                first[k] = time.monotonic() - launched
+
+        readers = [threading.Thread(target=first_line, args=(k,)) for k in range(self.robots)]
+        for reader in readers:
+            reader.start()
+        for reader, probe in zip(readers, probes):
+            reader.join(timeout=40)
+            probe.wait(timeout=40)
         arrivals = []
         capacity = int((self.args.warmup + self.args.seconds + 30) * 1000)  # samples a reader may get
         for k in range(self.robots):
