@@ -109,7 +109,10 @@ def measure(args, profiles, profile, domain):
 
 def summary(times):
     ordered = sorted(times)
-    pick = lambda q: ordered[min(len(ordered) - 1, int(q * len(ordered)))]  # noqa: E731
+
+    def pick(q):
+        return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
+
     return {"starts": len(times), "p50_s": pick(0.5), "p90_s": pick(0.9), "p99_s": pick(0.99), "max_s": ordered[-1],
             "over_0_5s": sum(1 for t in times if t > 0.5), "over_1s": sum(1 for t in times if t > 1.0),
             "times_s": times}
