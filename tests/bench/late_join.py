@@ -2,6 +2,7 @@
 sample, with rsg's participant profile and with Fast DDS's default announcement period.
 
     late_join.py --bin BUILD/bin --out DIR [--starts 100]
+    late_join.py --bin BUILD/bin --out DIR --render DIR/late_join.json   (redo the table)
 
 For each participant profile, on loopback with SIMPLE discovery: rsg_sim streams full frames at
 1 kHz into rsg_gateway, then rsg_echo --json --count 1 is started --starts times, one after the
@@ -21,6 +22,7 @@ profiles within one run. Writes DIR/late_join.json and DIR/late_join.md.
 
 import argparse
 import json
+import math
 import os
 import shutil
 import signal
@@ -110,8 +112,8 @@ def measure(args, profiles, profile, domain):
 def summary(times):
     ordered = sorted(times)
 
-    def pick(q):
-        return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
+    def pick(q):  # nearest rank: the smallest value with at least q of the starts at or below it
+        return ordered[max(0, math.ceil(q * len(ordered)) - 1)]
 
     return {"starts": len(times), "p50_s": pick(0.5), "p90_s": pick(0.9), "p99_s": pick(0.99), "max_s": ordered[-1],
             "over_0_5s": sum(1 for t in times if t > 0.5), "over_1s": sum(1 for t in times if t > 1.0),
@@ -138,9 +140,17 @@ def main():
     parser.add_argument("--out", required=True)
     parser.add_argument("--starts", type=int, default=100)
     parser.add_argument("--settle", type=float, default=1.5, help="seconds between the gateway's start and the first reader")
+    parser.add_argument("--render", help="only redo OUT/late_join.md (and the summaries) from this late_join.json")
     args = parser.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.render:
+        results = json.loads(Path(args.render).read_text())
+        for name in results["variants"]:
+            results["variants"][name] = summary(results["variants"][name]["times_s"])
+        (out / "late_join.json").write_text(json.dumps(results, indent=1) + "\n")
+        (out / "late_join.md").write_text(render(results))
+        return 0
     domain = os.getpid() % 80 + 140
     results = {"cpu": cpu_model(), "cores": os.cpu_count(), "starts": args.starts, "variants": {}}
     with tempfile.TemporaryDirectory(prefix="rsg_late_join_") as scratch:
