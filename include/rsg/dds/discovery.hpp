@@ -39,8 +39,10 @@ std::string check_discovery_server(const std::string& value);
 std::string check_peer(const std::string& value);
 
 /// Makes `qos` use the given servers or peers on `domain` (nothing changes when `options` is
-/// empty). Resolves host names (IPv4: rsg's participants use the UDPv4 transport). Throws
-/// std::invalid_argument naming the bad value.
+/// empty). With either, the participant announces itself at Fast DDS's default period (3 s), not
+/// rsg_participant's 0.5 s: each announcement then goes to every server or peer port. Resolves
+/// host names (IPv4: rsg's participants use the UDPv4 transport). Throws std::invalid_argument
+/// naming the bad value.
 void apply_discovery(const DiscoveryOptions& options, int domain,
                      eprosima::fastdds::dds::DomainParticipantQos& qos);
 
