@@ -32,6 +32,9 @@ int main(int argc, char** argv) {
     Qos reader_qos;  // every sample: reliable, all history
     dds_qset_reliability(reader_qos.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
     dds_qset_history(reader_qos.get(), DDS_HISTORY_KEEP_ALL, 0);
+    // Discovery is not symmetric: the test's publisher starts once it has matched this reader,
+    // which may learn of the writer later. Transient-local, it still gets what was sent before.
+    dds_qset_durability(reader_qos.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
     Entity reader(dds_create_reader(subscriber.get(), topic.get(), reader_qos.get(), nullptr), "reader");
     dds_set_status_mask(reader.get(), DDS_DATA_AVAILABLE_STATUS);
     Entity waitset(dds_create_waitset(participant.get()), "waitset");

@@ -44,6 +44,9 @@ int main(int argc, char** argv) {
   fdds::DataWriterQos qos = publisher.get_default_datawriter_qos();
   qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
   qos.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
+  // It starts once it has matched its readers, but a reader may match it later (discovery is not
+  // symmetric): a transient-local reader then still gets the whole stream from the history.
+  qos.durability().kind = fdds::TRANSIENT_LOCAL_DURABILITY_QOS;
   qos.deadline().period = eprosima::fastrtps::Duration_t(0, 100'000'000);  // like the gateway's
   fdds::DataWriter* writer = publisher.create_datawriter(participant.robot_state_topic(topic_name), qos);
   if (writer == nullptr || !rsg::test::wait_for_matched_readers(*writer, readers)) {
