@@ -26,7 +26,6 @@ import math
 import os
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -34,6 +33,10 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "tests" / "integration"))
+from harness import free_udp_port  # noqa: E402
+from scale import cpu_model  # noqa: E402  (tests/bench, next to this file)
+
 PROFILES = ROOT / "xml_profiles"
 
 # rsg_participant without its leaseAnnouncement, loaded after rsg.xml (files load in name order).
@@ -55,19 +58,6 @@ DEFAULT_ANNOUNCEMENTS = """<?xml version="1.0" encoding="UTF-8"?>
 
 VARIANTS = [("rsg_participant", "rsg's profile: announcements every 0.5 s"),
             ("fastdds_default_announcements", "Fast DDS's default: announcements every 3 s")]
-
-
-def free_udp_port():
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def cpu_model():
-    for line in Path("/proc/cpuinfo").read_text().splitlines():
-        if line.startswith("model name"):
-            return line.split(":", 1)[1].strip()
-    return "unknown CPU"
 
 
 def first_line_after(argv, timeout_s):
