@@ -52,9 +52,37 @@ def wanted(records, groups):
     return [line for line in records if json.loads(line)["group_select"] & groups == groups]
 
 
+def wait_echo_matched(process, consumed):
+    """Reads `process`'s stderr until rsg_echo says its reader matched one writer. The writer's side
+    of discovery is not enough: a volatile reader that learns of the writer later misses what was
+    sent in between. Lines read are kept in `consumed` for the test's messages; an echo that exits
+    first (its --timeout) ends the wait at end of file."""
+    for line in process.stderr:
+        consumed.append(line)
+        if line.startswith("rsg_echo: matched 1 writer of "):
+            return
+    raise AssertionError("rsg_echo exited before its reader matched the writer: " + "".join(consumed))
+
+
+def wait_stats(path, predicate, what, timeout_s=30):
+    """Waits until the gateway's --stats-file satisfies `predicate`."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        try:
+            with open(path) as f:
+                if predicate(json.load(f)):
+                    return
+        except (OSError, ValueError):
+            pass  # not written yet, or caught mid-write
+        time.sleep(0.05)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
 class EchoViews(unittest.TestCase):
     def check_views(self, start_stream, records_file):
-        """Starts one rsg_echo per view, then the stream; each must print exactly its subset."""
+        """Starts one rsg_echo per view, then the stream; each must print exactly its subset.
+        `start_stream(readers, echoes_matched)` starts the stream once the writer has matched the
+        readers and `echoes_matched()` has returned (each reader has matched the writer)."""
         # The expected counts are known only once the stream is recorded, so each echo runs
         # until the stream ends (--timeout) rather than for --count samples.
         with tempfile.TemporaryDirectory() as tmp:
@@ -62,15 +90,21 @@ class EchoViews(unittest.TestCase):
             for index, (view_args, groups) in enumerate(VIEWS):
                 output = open(os.path.join(tmp, f"echo{index}.jsonl"), "w+")
                 echoes.append((echo(*view_args, "--json", "--timeout", "5", stdout=output), output, view_args,
-                               groups))
-            stream = start_stream(len(echoes))
+                               groups, []))
+
+            def echoes_matched():
+                for process, _, _, _, consumed in echoes:
+                    wait_echo_matched(process, consumed)
+
+            stream = start_stream(len(echoes), echoes_matched)
             _, stream_err = stream.communicate(timeout=300)
             self.assertEqual(stream.returncode, 0, stream_err)
             with open(records_file) as f:
                 records = f.read().splitlines()
             self.assertGreater(len(records), 0)
-            for process, output, view_args, groups in echoes:
+            for process, output, view_args, groups, consumed in echoes:
                 _, err = process.communicate(timeout=60)
+                err = "".join(consumed) + err
                 output.seek(0)
                 printed = output.read().splitlines()
                 output.close()
@@ -85,12 +119,17 @@ class EchoViews(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             record = os.path.join(tmp, "published.jsonl")
 
-            def start(readers):
-                return subprocess.Popen(
+            def start(readers, echoes_matched):
+                # The publisher waits for its side of discovery, then for the go on stdin.
+                publisher = subprocess.Popen(
                     [ARGS.publish, "--domain", str(test_domain()), "--topic", "robot_state",
                      "--partition", "views_test", "--readers", str(readers), "--count", "256",
-                     "--rate", "1000", "--record", record],
-                    stderr=subprocess.PIPE, text=True)
+                     "--rate", "1000", "--record", record, "--wait-for-go"],
+                    stdin=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                echoes_matched()
+                publisher.stdin.write("go\n")
+                publisher.stdin.flush()
+                return publisher
 
             self.check_views(start, record)
 
@@ -98,16 +137,19 @@ class EchoViews(unittest.TestCase):
                          "rsg_sim and rsg_gateway not built")
     def test_views_of_the_sim_stream_through_the_gateway(self):
         port = free_udp_port()
-        gateway = subprocess.Popen(
-            [os.environ["RSG_GATEWAY"], "--listen", f"127.0.0.1:{port}", "--domain", str(test_domain()),
-             "--topic", "robot_state", "--partition", "views_test"],
-            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        try:
-            with tempfile.TemporaryDirectory() as tmp:
+        with tempfile.TemporaryDirectory() as tmp:
+            stats = os.path.join(tmp, "gateway.json")
+            gateway = subprocess.Popen(
+                [os.environ["RSG_GATEWAY"], "--listen", f"127.0.0.1:{port}", "--domain", str(test_domain()),
+                 "--topic", "robot_state", "--partition", "views_test", "--stats-file", stats],
+                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+            try:
                 record = os.path.join(tmp, "sent.jsonl")
 
-                def start(readers):
-                    time.sleep(3)  # discovery between the gateway and the echoes; not a pass/fail threshold
+                def start(readers, echoes_matched):
+                    # Both sides of discovery before the robot starts.
+                    wait_stats(stats, lambda s: s["state_readers"] >= readers, f"{readers} readers to match the gateway")
+                    echoes_matched()
                     return subprocess.Popen(
                         [os.environ["RSG_SIM"], "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "2000",
                          "--every", "1:g2", "--every", "3:g3", "--every", "10:g0,g5", "--every", "50:all",
@@ -115,9 +157,9 @@ class EchoViews(unittest.TestCase):
                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 
                 self.check_views(start, record)
-        finally:
-            gateway.send_signal(signal.SIGINT)
-            gateway.wait(timeout=30)
+            finally:
+                gateway.send_signal(signal.SIGINT)
+                gateway.communicate(timeout=30)
 
     def test_count_then_exit_0(self):
         with tempfile.TemporaryDirectory() as tmp:

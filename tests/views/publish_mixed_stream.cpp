@@ -3,6 +3,7 @@
 // each sample as canonical JSON, and waits until every reader has acknowledged everything.
 //
 //   rsg_views_publish --domain N --topic NAME [--partition P] --readers K --count N --record FILE
+//                     [--wait-for-go]
 #include <RobotState.h>
 
 #include <CLI/CLI.hpp>
@@ -10,6 +11,7 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fstream>
 #include <iostream>
+#include <string>
 #include <thread>
 
 #include "mixed_stream.hpp"
@@ -28,6 +30,7 @@ int main(int argc, char** argv) {
   std::size_t count = 256;
   double rate_hz = 1000;
   std::string record;
+  bool wait_for_go = false;
   CLI::App app{"Publishes the mixed-selection RobotState test stream.", "rsg_views_publish"};
   app.add_option("--domain", domain);
   app.add_option("--topic", topic_name);
@@ -36,6 +39,9 @@ int main(int argc, char** argv) {
   app.add_option("--count", count);
   app.add_option("--rate", rate_hz)->check(CLI::PositiveNumber);
   app.add_option("--record", record, "Canonical JSON of each published sample, one per line")->required();
+  app.add_flag("--wait-for-go", wait_for_go,
+               "Once the readers matched, publish only after a line arrives on stdin: the test's go once "
+               "each reader says it matched this writer too");
   CLI11_PARSE(app, argc, argv);
 
   rsg::load_profiles(rsg::default_profiles_dir());
@@ -52,6 +58,10 @@ int main(int argc, char** argv) {
   if (writer == nullptr || !rsg::test::wait_for_matched_readers(*writer, readers)) {
     std::cerr << "rsg_views_publish: the readers did not match\n";
     return 1;
+  }
+  if (wait_for_go) {
+    std::string go;
+    std::getline(std::cin, go);
   }
 
   std::ofstream out(record);
