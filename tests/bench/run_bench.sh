@@ -24,6 +24,9 @@
 #         RSG_BENCH_SCALE_SECONDS   measuring window per point (default 8)
 #         RSG_BENCH_SCALE_SERIES    scale.py --series (default robots,readers; add readers_multicast
 #                                   for M readers of rsg_participant_multicast: four more points)
+#         What the gateways send is forwarded and delivered on a kernel thread (--receive-off-sender),
+#         as a NIC leaves that work to the readers' machines; RSG_BENCH_SCALE_SENDER_PAYS=1 keeps the
+#         plain veth, which runs it inside the gateway's sendmsg (the committed runs before 2026-11-23 21:30)
 #   late_join  a reader started next to a running gateway, 100 times, with rsg's participant profile
 #         and with Fast DDS's default announcement period (late_join.py): time to the first sample,
 #         bench/late_join/ (late_join.json, late_join.md). About 1.5 minutes.
@@ -129,8 +132,10 @@ print(f"| {r['recorder_cpu_percent']} % of a core | {r['frames_sent']} | {r['sta
 PY
 }
 run_scale() {
+  local where=(--receive-off-sender)
+  [[ ${RSG_BENCH_SCALE_SENDER_PAYS:-0} == 1 ]] && where=()
   python3 "$here/scale.py" --bin "$build/bin" --out "$out/scale" --seconds "${RSG_BENCH_SCALE_SECONDS:-8}" \
-    --series "${RSG_BENCH_SCALE_SERIES:-robots,readers}" --discovery-server >/dev/null
+    --series "${RSG_BENCH_SCALE_SERIES:-robots,readers}" --discovery-server "${where[@]}" >/dev/null
 }
 report_scale() { cat "$out/scale/scale.md"; }
 

@@ -1,7 +1,7 @@
 """`make bench` scale suite: how rsg's cost grows with robots and with remote readers.
 
     scale.py --bin BUILD/bin --out DIR [--seconds 8] [--points 1,4,8,16] [--discovery-server]
-             [--series robots,readers,readers_multicast]
+             [--series robots,readers,readers_multicast] [--receive-off-sender]
 
 Runs on the network-namespace bed of tests/net (netbed.py): robots on `robot`, gateways on
 `gw`, readers on `ops1`/`ops2`, so every reader is remote (UDP over a veth bridge, MTU 1500).
@@ -35,6 +35,9 @@ The table's "others" is the host's busy time minus the bed's processes': the ker
 for the bed's traffic (softirq time, not charged to the processes; it grows with the traffic) plus
 any other work on a shared machine, which a quiet run does not have. It is approximate: /proc/stat
 is sampled on the scheduler tick, and at low load it can read below the bed's own CPU (shown as 0).
+With --receive-off-sender the bridge takes in what `gw` sends on a kernel thread (netbed.NetBed
+off_sender), so the gateways' CPU no longer includes the forwarding and the readers' receiving,
+which a veth otherwise runs inside the gateway's sendmsg and a NIC leaves to the readers' machines.
 Whole-host CPU (/proc/stat) is reported as context only: on a shared machine
 it measures everyone; the CPU of every process of the bed (robots, gateways, readers, server) is
 what rsg costs.
@@ -364,6 +367,9 @@ def main():
     parser.add_argument("--warmup", type=float, default=2.0)
     parser.add_argument("--points", default="1,4,8,16")
     parser.add_argument("--discovery-server", action="store_true")
+    parser.add_argument("--receive-off-sender", action="store_true",
+                        help="what the gateways send is forwarded and delivered on a kernel thread, not "
+                             "inside their sendmsg (netbed.NetBed off_sender): their CPU is then their own")
     parser.add_argument("--series", default="robots,readers",
                         help="comma-separated, in order, from: " + ", ".join(SERIES))
     parser.add_argument("--quiet-wait", type=float, default=120.0,
@@ -381,9 +387,10 @@ def main():
     if unknown:
         parser.error(f"--series: unknown {', '.join(unknown)} (known: {', '.join(SERIES)})")
     results = {"cpu": cpu_model(), "cores": os.cpu_count(), "seconds": args.seconds,
-               "discovery_server": args.discovery_server, "load_before": os.getloadavg(),
+               "discovery_server": args.discovery_server, "receive_off_sender": args.receive_off_sender,
+               "load_before": os.getloadavg(),
                **{name: [] for name in series}}
-    with NetBed() as bed:
+    with NetBed(off_sender=("gw",) if args.receive_off_sender else ()) as bed:
         for sweep, x in [(name, n) for name in series for n in points]:
             quiet_after = wait_for_quiet(args.quiet_wait)
             with tempfile.TemporaryDirectory(prefix="rsg_scale_") as scratch:

@@ -82,14 +82,22 @@ def sweep_stale():
 def require_tools(*tools):
     missing = [tool for tool in tools if shutil.which(tool) is None]
     if missing:
-        raise TestFailure(f"this test needs {', '.join(missing)} (Debian packages iproute2, nftables; "
+        raise TestFailure(f"this test needs {', '.join(missing)} (Debian packages iproute2, nftables, ethtool; "
                           f"`make deps` installs them)")
 
 
 class NetBed:
-    """The four hosts and the bridge of one run. Use as a context manager."""
+    """The four hosts and the bridge of one run. Use as a context manager.
 
-    def __init__(self):
+    `off_sender` names hosts whose outgoing traffic the bridge takes in on a kernel thread of its
+    own (the bridge port's veth in NAPI mode, GRO on, threaded NAPI; needs ethtool). By default a
+    veth delivers what a process sends inside that process's system call: the bridge, the
+    receiving host's IP stack and the receiver's wake-up are all charged to the sender, work that a
+    NIC leaves to the receiving machine. With the host listed, the sender pays for its own send
+    only, and the rest runs on `napi/b-<host>-…`."""
+
+    def __init__(self, off_sender=()):
+        self.off_sender = tuple(off_sender)
         self.run_id = f"rsgnet{os.getpid()}"
         self.bridge = f"{self.run_id}-br"
         self.made = []
@@ -102,7 +110,7 @@ class NetBed:
         if os.geteuid() != 0:
             raise TestFailure("the network test bed needs root (network namespaces, veth, nftables): "
                               "run as root, as CI does")
-        require_tools("ip", "nft", "tc")
+        require_tools("ip", "nft", "tc", *(("ethtool",) if self.off_sender else ()))
         sweep_stale()
         atexit.register(self.close)
         for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
@@ -139,6 +147,15 @@ class NetBed:
             # rsg's participants ask for 4 MiB socket buffers; the kernel caps them at rmem_max.
             for key in ("net.core.rmem_max", "net.core.wmem_max"):
                 sh("ip", "netns", "exec", name, "sysctl", "-qw", f"{key}=8388608")
+        for host in self.off_sender:
+            # NAPI on a veth needs GRO and both ends up; `threaded` then moves its poll loop, and the
+            # forwarding and delivery it runs, from the sender's softirq to a kernel thread. A veth
+            # hands a packet to its peer's NAPI only if the sending end has no TSO (or the peer
+            # forwards UDP GRO); TSO means nothing to rsg's UDP, so it goes.
+            port = f"b-{host}"
+            sh("ip", "netns", "exec", self.ns(host), "ethtool", "-K", "eth0", "tso", "off")
+            sh("ip", "netns", "exec", self.bridge, "ethtool", "-K", port, "gro", "on")
+            sh("ip", "netns", "exec", self.bridge, "sh", "-c", f"echo 1 > /sys/class/net/{port}/threaded")
 
     def close(self):
         for _, process in self.children:
