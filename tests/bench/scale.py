@@ -330,6 +330,11 @@ def render(out, results):
     (out / "scale.json").write_text(json.dumps(results, indent=1) + "\n")
     text = (f"# Scale suite ({results['cpu']}, {results['cores']} cores, {results['seconds']:.0f} s windows, "
             f"discovery server: {results['discovery_server']}, load average before {results['load_before'][0]:.1f})\n\n"
+            + ("What the gateways send is forwarded and delivered on a kernel thread (--receive-off-sender): "
+               "their CPU is their own send, not the readers' receiving.\n\n"
+               if results.get("receive_off_sender") else
+               "Plain veth: the forwarding and the readers' receiving run inside the gateways' sendmsg and "
+               "count as their CPU.\n\n")
             + "".join(sections)
             + "Least-squares slopes over the points not machine-limited (over all of them where fewer than "
               "two were not), and latency from the robot's send to the remote reader's receive:\n\n"
