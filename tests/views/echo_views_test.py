@@ -10,12 +10,15 @@ import argparse
 import json
 import os
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
 import time
 import unittest
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
+from harness import free_udp_port, test_domain, wait_for_stats  # noqa: E402
 
 ARGS = None
 
@@ -28,16 +31,6 @@ VIEWS = [
     (["--view", "view_full"], 0b111111),
     ([], 0),
 ]
-
-
-def test_domain():
-    return os.getpid() % 200 + 10
-
-
-def free_udp_port():
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 def echo(*extra, partition="views_test", stdout=subprocess.PIPE):
@@ -62,20 +55,6 @@ def wait_echo_matched(process, consumed):
         if line.startswith("rsg_echo: matched 1 writer of "):
             return
     raise AssertionError("rsg_echo exited before its reader matched the writer: " + "".join(consumed))
-
-
-def wait_stats(path, predicate, what, timeout_s=30):
-    """Waits until the gateway's --stats-file satisfies `predicate`."""
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        try:
-            with open(path) as f:
-                if predicate(json.load(f)):
-                    return
-        except (OSError, ValueError):
-            pass  # not written yet, or caught mid-write
-        time.sleep(0.05)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 class EchoViews(unittest.TestCase):
@@ -148,7 +127,7 @@ class EchoViews(unittest.TestCase):
 
                 def start(readers, echoes_matched):
                     # Both sides of discovery before the robot starts.
-                    wait_stats(stats, lambda s: s["state_readers"] >= readers, f"{readers} readers to match the gateway")
+                    wait_for_stats(stats, lambda s: s["state_readers"] >= readers, f"{readers} readers to match the gateway")
                     echoes_matched()
                     return subprocess.Popen(
                         [os.environ["RSG_SIM"], "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "2000",

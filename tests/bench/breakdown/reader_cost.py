@@ -9,7 +9,9 @@ datagram within the sender's system call: the bridge, the reader host's IP stack
 two fragments of a 2.2 kB sample) and the wake-up of the reader run as network receive softirq work
 (`net_rx_action`) on the gateway's own thread. With a NIC that work happens on the reader's
 machine. So the gateway's CPU splits into the receive-side work the bed adds (samples under
-`net_rx_action`) and the rest: what the gateway would cost on a real network.
+`net_rx_action`) and the rest: what the gateway would cost on a real network. (`scale.py
+--receive-off-sender` measures the rest directly, with that work moved to a kernel thread; this
+script keeps the plain veth on purpose, to show the split.)
 
 Prints a table per series and the per-reader slopes of both parts.
 """
