@@ -8,8 +8,11 @@ FUZZ_SECONDS ?= 30
 # Fast DDS 2.9.1 deletes an RTPSReader through the wrong type in its own destructor
 # (~RTPSReader, 64 vs 56 bytes); that report is about the library, not about rsg.
 ASAN_OPTIONS ?= new_delete_type_mismatch=0
-PACKAGES   := $(shell grep -v '^\s*\#' docker/packages.txt)
-# ccache (in docker/packages.txt) makes the three builds of `make test` and a rebuild after a
+# Debian packages by need: build, run (make demo installs these two), test (make deps adds it).
+packages    = $(shell grep -hv '^\s*\#' $(addprefix docker/packages/,$(addsuffix .txt,$(1))))
+# Project-local tools from PyPI and the Go module proxy, pinned with hashes (git-ignored).
+DEPS_DIR   ?= $(CURDIR)/.deps
+# ccache (in docker/packages/build.txt) makes the three builds of `make test` and a rebuild after a
 # branch switch cheap; paths are taken relative to the checkout so clones share the cache.
 CCACHE     := -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache
 export CCACHE_BASEDIR := $(CURDIR)
@@ -19,12 +22,14 @@ SUDO       := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 SHELL      := /bin/bash
 .SHELLFLAGS := -o pipefail -c
 
-.PHONY: all deps build install test unit-asan fuzz fuzz-build demo bench format clean wireshark-plugin
+
+.PHONY: all deps deps-run build build-demo install test unit-asan fuzz fuzz-build demo bench format clean wireshark-plugin
 
 all: build
 
-deps:
-	@missing=$$(for p in $(PACKAGES); do \
+# Installs what is missing of the Debian packages of the needs named in $(1).
+define apt_install
+	@missing=$$(for p in $(call packages,$(1)); do \
 	  dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
 	  echo "make deps: installing" $$missing; \
@@ -32,6 +37,15 @@ deps:
 	  $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
+endef
+
+# What building and running needs: enough for make demo.
+deps-run:
+	$(call apt_install,build run)
+
+# Everything make test needs: Debian packages, npm packages, the Python environments and Go tools.
+deps: deps-run
+	$(call apt_install,test)
 	@# Node and npm for the tests that read MCAP files with @mcap/core (Debian's, unless a node is there).
 	@command -v npm >/dev/null || { $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends nodejs npm; }
@@ -39,6 +53,7 @@ deps:
 	  npm ci --prefix tests/record --no-audit --no-fund
 	@[ tests/view/package-lock.json -ot tests/view/node_modules/.package-lock.json ] || \
 	  npm ci --prefix tests/view --no-audit --no-fund
+	@for script in tools/deps/*.sh; do DEPS_DIR=$(DEPS_DIR) $$script || exit 1; done
 
 build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CCACHE)
@@ -71,7 +86,13 @@ test: build
 	$(MAKE) fuzz FUZZ_SECONDS=20
 	@tests/summarize.sh $(BUILD)/ctest.log $(ASAN_BUILD)/ctest.log -- $(FUZZ_BUILD)/fuzz.log
 
-demo: build
+# Only what the demo runs, with only the build and run packages: a fresh machine shows samples fast.
+DEMO_TARGETS := rsg_gateway rsg_sim rsg_echo rsg_view
+build-demo: deps-run
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CCACHE)
+	cmake --build $(BUILD) -j $(JOBS) --target $(DEMO_TARGETS)
+
+demo: build-demo
 	src/tools/demo.sh $(BUILD)/bin
 
 bench: build
