@@ -110,3 +110,14 @@ format:
 
 clean:
 	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD)
+
+# The container image (docs/container.md) with the engine that works here: Docker when `docker info`
+# answers, else podman with docker/containers.conf (docker/engine.sh). IMAGE names it.
+IMAGE ?= rsg
+.PHONY: image test-image
+image:
+	docker/build-image.sh $(IMAGE)
+
+# Builds the image, then runs the pipeline, rsg_view and docker/compose.yaml in containers.
+test-image: deps
+	RSG_IMAGE=$(IMAGE) tests/image/run.sh

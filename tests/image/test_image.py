@@ -1,0 +1,348 @@
+"""The image, run by a real engine: every tool in its own container, on the host network, talking
+over loopback and the host's /dev/shm (what docker/compose.yaml sets).
+
+  pipeline      rsg_sim -> rsg_gateway -> rsg_echo --json and rsg_record: every frame exact at the
+                echo, the MCAP file read by the reference reader (tests/record/check_recording.mjs)
+                to the values sent; the image's HEALTHCHECK passes on the running gateway
+  view          rsg_view serves its page to Debian's headless Chromium on the host
+                (tests/view/check_page.mjs): live samples rsg_sim sent, plotted by Chart.js
+  restart       the gateway container killed (the Fast DDS 2.9.1 abort's effect) and run again, as
+                `restart: on-failure` does: the running echo and recorder resume, and every sample
+                the echo printed is one rsg_sim sent, in order
+  compose       docker/compose.yaml's services with podman-compose (docker compose with Docker):
+                the page on RSG_VIEW_PORT, the echo's samples, the recording in the volume
+
+    tests/image/run.sh          # builds the image first (make test-image)
+    test_image.py --engine "podman --runtime runc" --image rsg [--case NAME]
+"""
+
+import argparse
+import json
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "integration"))
+from harness import (TestFailure, check, free_udp_port, read_json, read_json_lines, test_domain,  # noqa: E402
+                     wait_for, wait_for_stats, wait_reader_matched)
+
+SELECTIONS = ["--every", "1:q,dq,time", "--every", "3:g0", "--every", "10:all"]
+COUNT = 1000
+# Inside the image: the entrypoint's stats file (the HEALTHCHECK reads it) and where tests mount.
+STATS_DIR, DATA = "/run/rsg", "/data"
+
+
+def free_tcp_port():
+    import socket
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+class Containers:
+    """The containers of one run: each started attached (`ENGINE run --rm`), its stdout and stderr
+    in LABEL.out / LABEL.err of the scratch directory, removed at the end whatever happened."""
+
+    def __init__(self, engine, image):
+        self.engine = shlex.split(engine)
+        self.name = "podman" if "podman" in self.engine[0] else "docker"
+        self.image = image
+        self.dir = Path(tempfile.mkdtemp(prefix="rsg_image_"))
+        self.data = self.dir / "data"  # mounted at /data: the containers' user (uid 10001) writes there
+        self.data.mkdir()
+        self.stats_dir = self.dir / "gateway"  # mounted over /run/rsg: the gateway's stats file
+        self.stats_dir.mkdir()
+        for path in (self.data, self.stats_dir):
+            path.chmod(0o777)
+        self.stats = self.stats_dir / "gateway-stats.json"
+        self.domain = test_domain()
+        self.prefix = f"rsg-image-test-{os.getpid()}"
+        self.processes = {}
+        self.names = set()
+
+    def container(self, label):
+        return f"{self.prefix}-{label}"
+
+    def engine_run(self, *args, timeout_s=60, check_status=True):
+        result = subprocess.run([*self.engine, *args], capture_output=True, text=True, timeout=timeout_s)
+        if check_status:
+            check(result.returncode == 0, f"{self.name} {' '.join(args)}: {result.stderr.strip()}")
+        return result
+
+    def start(self, label, *argv, entrypoint=None, mounts=()):
+        """Starts `argv` in a container of the image (the gateway's entrypoint unless `entrypoint`)."""
+        name = self.container(label)
+        command = [*self.engine, "run", "--rm", "--name", name, "--network", "host", "--ipc", "host",
+                   "-v", f"{self.data}:{DATA}", *[arg for mount in mounts for arg in ("-v", mount)]]
+        if entrypoint:
+            command += ["--entrypoint", entrypoint]
+        command += [self.image, *map(str, argv)]
+        print(f"[image] start {label}: {' '.join(command)}", flush=True)
+        out = open(self.dir / f"{label}.out", "ab")
+        err = open(self.dir / f"{label}.err", "ab")
+        self.processes[label] = subprocess.Popen(command, stdout=out, stderr=err)
+        self.names.add(name)
+        return self.processes[label]
+
+    def gateway(self, port):
+        return self.start("gateway", "--listen", f"127.0.0.1:{port}", "--domain", self.domain,
+                          "--expected-rate", "500", mounts=[f"{self.stats_dir}:{STATS_DIR}"])
+
+    def wait(self, label, timeout_s=60):
+        try:
+            return self.processes[label].wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            raise TestFailure(f"the {label} container did not exit within {timeout_s} s")
+
+    def stop(self, label, timeout_s=30):
+        """`ENGINE stop`: SIGTERM to the tool, as an operator's; returns the tool's exit status."""
+        self.engine_run("stop", "-t", str(timeout_s), self.container(label), timeout_s=timeout_s + 30)
+        return self.wait(label)
+
+    def output(self, label):
+        return self.dir / f"{label}.out"
+
+    def stderr(self, label):
+        path = self.dir / f"{label}.err"
+        return path.read_text(errors="replace") if path.exists() else ""
+
+    def cleanup(self, keep):
+        for name in self.names:
+            subprocess.run([*self.engine, "rm", "-f", "-t", "0", name], capture_output=True)
+        for process in self.processes.values():
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+        subprocess.run(["fastdds", "shm", "clean"], capture_output=True)
+        if not keep:
+            shutil.rmtree(self.dir, ignore_errors=True)
+
+    def dump_logs(self):
+        print(f"(outputs are in {self.dir})")
+        for label in self.processes:
+            lines = self.stderr(label).splitlines()
+            if lines:
+                print(f"--- {label}.err (last 20 lines)")
+                print("\n".join(line[:300] for line in lines[-20:]))
+
+
+def node(script, *args, timeout_s=90):
+    """Runs one of the project's Node checks; fails (never skips) when Node or its packages are missing."""
+    folder = (ROOT / script).parent
+    check(shutil.which("node") is not None, "node is not installed: run `make deps`")
+    check((folder / "node_modules").is_dir(), f"{folder.relative_to(ROOT)}/node_modules is missing: run `make deps`")
+    result = subprocess.run(["node", str(ROOT / script), *map(str, args)], capture_output=True, text=True,
+                            timeout=timeout_s)
+    check(result.returncode == 0, f"{script}: {result.stderr.strip()} {result.stdout.strip()}")
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
+def healthy(c, container):
+    """The image's HEALTHCHECK on a running container: podman runs it on demand (its timer needs
+    systemd), Docker runs it itself and reports the state."""
+    if c.name == "podman":
+        return c.engine_run("healthcheck", "run", container, check_status=False).returncode == 0
+    state = c.engine_run("inspect", "--format", "{{.State.Health.Status}}", container, check_status=False)
+    return state.stdout.strip() == "healthy"
+
+
+def is_subsequence(items, sequence):
+    it = iter(sequence)
+    return all(any(item == candidate for candidate in it) for item in items)
+
+
+def pipeline(c):
+    port = free_udp_port()
+    c.gateway(port)
+    wait_for_stats(c.stats, lambda s: True, "the gateway container to start", timeout_s=60)
+    c.start("echo", "--domain", c.domain, "--json", "--count", COUNT, "--timeout", "90", entrypoint="rsg_echo")
+    c.start("record", "--domain", c.domain, "--out", f"{DATA}/pipeline.mcap", entrypoint="rsg_record")
+    wait_for_stats(c.stats, lambda s: s["state_readers"] >= 2, "2 readers to match the gateway", timeout_s=60)
+    wait_reader_matched(c, "echo", "rsg_echo")
+    wait_reader_matched(c, "record", "rsg_record")
+    c.start("sim", "--to", f"127.0.0.1:{port}", "--rate", "500", "--count", COUNT, *SELECTIONS,
+            "--record", f"{DATA}/sim.jsonl", entrypoint="rsg_sim")
+    check(c.wait("sim") == 0, f"rsg_sim exited non-zero: {c.stderr('sim')}")
+    check(c.wait("echo", 90) == 0, f"rsg_echo did not receive every sample: {c.stderr('echo')[-500:]}")
+
+    sent = read_json_lines(c.data / "sim.jsonl")
+    received = read_json_lines(c.output("echo"))
+    check(len(sent) == COUNT, f"rsg_sim recorded {len(sent)} frames, not {COUNT}")
+    check(len(received) == COUNT, f"rsg_echo printed {len(received)} samples for {COUNT} frames")
+    for index, (expected, actual) in enumerate(zip(sent, received)):
+        check(actual == expected, f"sample {index} differs from the frame sent:\n  sent {expected}\n  got  {actual}")
+    stats = wait_for_stats(c.stats, lambda s: s["frames_published"] >= COUNT, "the gateway to publish every frame")
+    check((stats["frames_received"], stats["lost"], sum(stats["invalid"].values())) == (COUNT, 0, 0),
+          f"gateway counters: {stats}")
+    check(healthy(c, c.container("gateway")), "the image's HEALTHCHECK fails on a running gateway")
+
+    time.sleep(1.5)  # the last samples and a status sample reach the recorder
+    check(c.stop("record") == 0, f"rsg_record did not exit 0 on SIGTERM: {c.stderr('record')}")
+    check("dropped 0 (sequence gaps), 0 (lost in DDS)" in c.stderr("record"), c.stderr("record"))
+    seen = node("tests/record/check_recording.mjs", c.data / "pipeline.mcap", "--frames", c.data / "sim.jsonl")
+    check(seen["states"] == COUNT and seen["statuses"] >= 1, f"the reference reader read {seen}")
+    print(f"[image] pipeline: {COUNT} frames exact at rsg_echo and in the MCAP file ({seen})", flush=True)
+
+
+def view_and_restart(c):
+    """One gateway, a streaming rsg_sim, and long-running readers: the page first, then the kill."""
+    port = free_udp_port()
+    c.gateway(port)
+    wait_for_stats(c.stats, lambda s: True, "the gateway container to start", timeout_s=60)
+    ws_port = free_tcp_port()
+    c.start("view", "--domain", c.domain, "--listen", f"127.0.0.1:{ws_port}", entrypoint="rsg_view")
+    c.start("echo2", "--domain", c.domain, "--json", entrypoint="rsg_echo")
+    c.start("record2", "--domain", c.domain, "--out", f"{DATA}/restart.mcap", "--chunk-size", "65536",
+            entrypoint="rsg_record")
+    wait_for_stats(c.stats, lambda s: s["state_readers"] >= 3, "3 readers to match the gateway", timeout_s=60)
+    for label, tool in (("view", "rsg_view"), ("echo2", "rsg_echo"), ("record2", "rsg_record")):
+        wait_reader_matched(c, label, tool)
+    wait_for(lambda: "serving" in c.stderr("view"), "rsg_view to listen")
+    c.start("sim2", "--to", f"127.0.0.1:{port}", "--rate", "500", "--record", f"{DATA}/sim2.jsonl",
+            entrypoint="rsg_sim")
+
+    # The page, from the container, in Debian's headless Chromium on the host.
+    chromium = shutil.which("chromium")
+    check(chromium is not None, "chromium is not installed: run `make deps`")
+    devtools = free_tcp_port()
+    browser = subprocess.Popen([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+                                f"--user-data-dir={c.dir / 'chromium'}", f"--remote-debugging-port={devtools}",
+                                "about:blank"], stdout=subprocess.DEVNULL, stderr=open(c.dir / "chromium.err", "wb"))
+    try:
+        shown = node("tests/view/check_page.mjs", devtools, f"http://127.0.0.1:{ws_port}/", c.dir / "rsg_view.png")
+    finally:
+        browser.kill()
+        browser.wait()
+    sent = {", ".join(f"{v:.4f}" for v in frame["fields"]["q"]) for frame in read_json_lines(c.data / "sim2.jsonl")
+            if "q" in frame["fields"]}
+    check(shown["last_q"] in sent, f"the page shows q = {shown['last_q']}, which rsg_sim never sent")
+    check(shown["chart_js"] and shown["q_points"] >= 50, f"Chart.js did not plot: {shown}")
+    print(f"[image] view: the page showed {shown}", flush=True)
+    check(c.stop("view") == 0, "rsg_view did not exit 0 on SIGTERM")
+
+    # The kill, then the gateway again with the same command (what `restart: on-failure` runs).
+    wait_for(lambda: len(read_json_lines(c.output("echo2"))) >= 200, "rsg_echo's first samples")
+    c.engine_run("kill", c.container("gateway"))
+    status = c.wait("gateway")
+    check(status != 0, f"the killed gateway container exited {status}")
+    time.sleep(1.0)
+    before = len(read_json_lines(c.output("echo2")))
+    c.stats.unlink(missing_ok=True)
+    c.gateway(port)
+    wait_for_stats(c.stats, lambda s: s["frames_published"] > 0, "the gateway to publish again", timeout_s=60)
+    wait_for(lambda: len(read_json_lines(c.output("echo2"))) >= before + 500,
+             f"rsg_echo to resume ({before} samples before the kill)", timeout_s=60)
+    check(c.processes["echo2"].poll() is None and c.processes["record2"].poll() is None,
+          "a reader exited when the gateway was killed")
+    check(c.stop("sim2") == 0, f"rsg_sim did not exit 0 on SIGTERM: {c.stderr('sim2')}")
+    time.sleep(1.0)
+    check(c.stop("echo2") == 0, "rsg_echo did not exit 0 on SIGTERM")
+    check(c.stop("record2") == 0, f"rsg_record did not exit 0 on SIGTERM: {c.stderr('record2')}")
+
+    received = read_json_lines(c.output("echo2"))
+    sent = read_json_lines(c.data / "sim2.jsonl")
+    check(len(received) >= before + 500, f"rsg_echo printed {len(received)} samples, {before} before the kill")
+    check(is_subsequence(received, sent), "rsg_echo printed a sample rsg_sim did not send, or out of order")
+    seen = node("tests/record/check_recording.mjs", c.data / "restart.mcap")
+    check(seen["states"] >= before + 500, f"the recording holds {seen['states']} states, {before} before the kill")
+    print(f"[image] restart: {before} samples before the kill, {len(received)} in all, every one sent by "
+          f"rsg_sim, in order; the recording is readable ({seen['states']} states)", flush=True)
+    check(c.stop("gateway") == 0, "the gateway did not exit 0 on SIGTERM")
+
+
+def compose(c):
+    """docker/compose.yaml as it is, on a domain and ports of this run, the image already built."""
+    if c.name == "podman":
+        tool = shutil.which("podman-compose")
+        check(tool is not None, "podman-compose is not installed: run `make deps`")
+        command = [tool]
+    else:
+        command = ["docker", "compose"]
+    project = c.prefix
+    env = {**os.environ, "RSG_IMAGE": c.image, "RSG_DOMAIN": str(c.domain), "RSG_ROBOT_PORT": str(free_udp_port()),
+           "RSG_VIEW_PORT": str(free_tcp_port())}
+    compose_file = ["-p", project, "-f", str(ROOT / "docker" / "compose.yaml")]
+
+    def run(*args, timeout_s=120):
+        result = subprocess.run([*command, *compose_file, *args], env=env, capture_output=True, text=True,
+                                timeout=timeout_s)
+        (c.dir / "compose.log").open("a").write(f"$ {' '.join(args)}\n{result.stdout}{result.stderr}\n")
+        check(result.returncode == 0, f"compose {' '.join(args)}: {result.stderr.strip()[-800:]}")
+        return result.stdout
+
+    def logs(service):
+        result = c.engine_run("logs", names[service], check_status=False)
+        return result.stdout + result.stderr
+
+    names = {}
+    try:
+        run("up", "-d", "--no-build")
+        listed = c.engine_run("ps", "-a", "--format", "{{.Names}}").stdout.split()
+        for service in ("gateway", "sim", "echo", "record", "view"):
+            found = [name for name in listed if name in (f"{project}_{service}_1", f"{project}-{service}-1")]
+            check(found, f"compose started no {service} container: {listed}")
+            names[service] = found[0]
+        wait_for(lambda: healthy(c, names["gateway"]), "the gateway container to be healthy", timeout_s=60)
+        wait_for(lambda: logs("echo").count('"fields"') >= 100, "rsg_echo's samples", timeout_s=60)
+        url = f"http://127.0.0.1:{env['RSG_VIEW_PORT']}/"
+        page = wait_for(lambda: fetch(url), f"rsg_view's page at {url}", timeout_s=60)
+        check("<html" in page.lower(), f"{url} is not the page: {page[:200]}")
+        time.sleep(2.0)
+        run("stop", "record")
+        volume = c.engine_run("volume", "inspect", "--format", "{{.Mountpoint}}", f"{project}_recordings").stdout.strip()
+        files = sorted(Path(volume).glob("robot*.mcap"))
+        check(files, f"no recording in the volume ({volume})")
+        seen = node("tests/record/check_recording.mjs", files[0])
+        check(seen["states"] >= 100, f"the recording in the volume holds {seen['states']} states")
+        print(f"[image] compose: gateway healthy, echo printing, page at {url}, {files[0].name} in the volume "
+              f"({seen['states']} states)", flush=True)
+    finally:
+        subprocess.run([*command, *compose_file, "down", "-v"], env=env, capture_output=True, timeout=180)
+
+
+def fetch(url):
+    try:
+        with urllib.request.urlopen(url, timeout=5) as response:
+            return response.read().decode(errors="replace")
+    except OSError:
+        return None
+
+
+CASES = {"pipeline": pipeline, "view_and_restart": view_and_restart, "compose": compose}
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--engine", required=True, help='the engine command, e.g. "podman --runtime runc"')
+    parser.add_argument("--image", default="rsg")
+    parser.add_argument("--case", action="append", choices=sorted(CASES), help="default: every case")
+    args = parser.parse_args()
+    passed = failed = 0
+    for name in args.case or list(CASES):
+        c = Containers(args.engine, args.image)
+        ok = False
+        start = time.monotonic()
+        try:
+            CASES[name](c)
+            ok = True
+        except (TestFailure, subprocess.TimeoutExpired) as failure:
+            print(f"[image.{name}] FAILED: {failure}")
+            c.dump_logs()
+        finally:
+            c.cleanup(keep=not ok)
+        print(f"[image.{name}] {'passed' if ok else 'FAILED'} in {time.monotonic() - start:.0f} s", flush=True)
+        passed, failed = passed + ok, failed + (not ok)
+    print(f"image: {passed} passed, {failed} failed")
+    return 0 if failed == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
