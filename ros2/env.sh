@@ -1,0 +1,49 @@
+# Source me (bash or zsh): the project-local ROS 2 Kilted that `make deps` installs.
+#
+#   . ros2/env.sh
+#   python -c 'import rclpy; from rsg_msgs.msg import RobotState'
+#
+# .deps/ros2            the Python environment of the ROS 2 wheels (tools/deps/python/ros2.txt):
+#                       rclpy, rmw_fastrtps_cpp on Fast DDS 3.2, std/sensor/geometry_msgs, rosidl
+# .deps/ros2_ws/install rsg_msgs (ros2/rsg_msgs) and tf2_msgs (tests/ros2/tf2_msgs) built by
+#                       ament_cmake + rosidl from those wheels (tools/deps/ros2_ws.sh)
+#
+# The wheels put their libraries in the environment's lib/ and in site-packages/ros_*.libs and
+# find packages through the ament index: this sets PATH, LD_LIBRARY_PATH, PYTHONPATH,
+# AMENT_PREFIX_PATH, CMAKE_PREFIX_PATH and RMW_IMPLEMENTATION=rmw_fastrtps_cpp. It also tells the
+# wheels' own start-up hook (ros_wheels_bootstrapper, which re-executes Python once to set
+# LD_LIBRARY_PATH) that this is done. ROS_DOMAIN_ID is left as it is: use the gateway's --domain.
+# Another environment: RSG_DEPS_DIR=/path/to/.deps before sourcing.
+
+if [ -n "${BASH_SOURCE:-}" ]; then
+  _rsg_ros2_here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+else
+  _rsg_ros2_here=$(cd "$(dirname "$0")" && pwd)  # zsh sets $0 to the sourced file
+fi
+_rsg_deps=${RSG_DEPS_DIR:-$(dirname "$_rsg_ros2_here")/.deps}
+export RSG_ROS2_VENV=$_rsg_deps/ros2
+export RSG_ROS2_INSTALL=$_rsg_deps/ros2_ws/install
+
+if [ ! -x "$RSG_ROS2_VENV/bin/python" ] || [ ! -d "$RSG_ROS2_INSTALL/share/rsg_msgs" ]; then
+  echo "ros2/env.sh: no ROS 2 environment in $_rsg_deps (ros2, ros2_ws/install): run make deps" >&2
+  unset _rsg_ros2_here _rsg_deps
+  return 1 2>/dev/null || exit 1
+fi
+
+_rsg_site=$("$RSG_ROS2_VENV/bin/python" -c 'import sysconfig; print(sysconfig.get_path("purelib"))' \
+  2>/dev/null || echo "$RSG_ROS2_VENV/lib/python3.11/site-packages")
+_rsg_libs=$RSG_ROS2_INSTALL/lib:$RSG_ROS2_VENV/lib
+for _rsg_dir in "$_rsg_site"/ros_*.libs; do
+  [ -d "$_rsg_dir" ] && _rsg_libs=$_rsg_libs:$_rsg_dir
+done
+
+export PATH=$RSG_ROS2_VENV/bin:$PATH
+export LD_LIBRARY_PATH=$_rsg_libs${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+export PYTHONPATH=$RSG_ROS2_INSTALL/${_rsg_site#"$RSG_ROS2_VENV"/}${PYTHONPATH:+:$PYTHONPATH}
+export AMENT_PREFIX_PATH=$RSG_ROS2_INSTALL:$RSG_ROS2_VENV
+export CMAKE_PREFIX_PATH=$RSG_ROS2_INSTALL:$RSG_ROS2_VENV${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}
+export RMW_IMPLEMENTATION=rmw_fastrtps_cpp
+export ROS_DISTRO=kilted ROS_VERSION=2 ROS_PYTHON_VERSION=3
+export _ROS_WHEELS_BOOTSTRAP_COMPLETE=1
+
+unset _rsg_ros2_here _rsg_deps _rsg_site _rsg_libs _rsg_dir
