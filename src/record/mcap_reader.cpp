@@ -66,8 +66,13 @@ class Scanner {
         return finish(Status::truncated, "the file ends without a Data End record or footer", offset);
       const auto record = cursor.next();
       if (!record) return finish(Status::truncated, "the file ends inside a record", offset);
-      if (first && record->opcode != Opcode::header)
-        return finish(Status::malformed, "the first record is not a header", offset);
+      if (first) {
+        if (record->opcode != Opcode::header)
+          return finish(Status::malformed, "the first record is not a header", offset);
+        const auto header = parse_record<Header>(record->content);
+        if (!header) return finish(Status::malformed, "the header record is too short", offset);
+        visitor_.on_header(*header);
+      }
       first = false;
       switch (record->opcode) {
         case Opcode::data_end:

@@ -20,6 +20,8 @@ namespace rsg::mcap {
 class RecordVisitor {
  public:
   virtual ~RecordVisitor() = default;
+  /// The file's Header record, before anything else.
+  virtual void on_header(const Header&) {}
   virtual void on_schema(const Schema&) {}
   virtual void on_channel(const Channel&) {}
   /// Return false to stop the scan (status `stopped`).

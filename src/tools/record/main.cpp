@@ -3,7 +3,8 @@
 //
 // Exit status: 0 after --duration or on SIGINT/SIGTERM with the file finished; 1 when the file
 // cannot be written (the error names it; what was recorded stays readable) or DDS fails; 2 on
-// usage errors (including unknown profiles).
+// usage errors (including unknown profiles). With --recover FILE: 0 when FILE was read to its end
+// or cut off (a killed recorder's file), 1 when it is damaged inside or --out cannot be written.
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -13,6 +14,7 @@
 #include <optional>
 
 #include "matched_writers.hpp"
+#include "mcap_recover.hpp"
 #include "mcap_writer.hpp"
 #include "monitor_options.hpp"
 #include "monitor_readers.hpp"
@@ -44,6 +46,7 @@ struct Options : rsg::tools::MonitorOptions {
   double split_mb = 0;
   std::size_t chunk_bytes = rsg::mcap::WriterOptions{}.chunk_bytes;
   bool fsync = false;
+  fs::path recover;  // --recover: copy this damaged file to --out instead of recording
 };
 
 std::uint64_t now_ns() {
@@ -62,26 +65,52 @@ class Recording {
     open();
   }
 
-  void write_state(const rsg::RobotState& sample, const fdds::SampleInfo& info) {
+  /// Adds a sample to the batch that write_batch() writes.
+  void add_state(const rsg::RobotState& sample, const fdds::SampleInfo& info) {
     ++states;
-    write(channels_.robot_state, serializer_.serialize(sample), info);
+    add(channels_.robot_state, serializer_.serialize(sample), info);
   }
-  void write_status(const rsg::GatewayStatus& sample, const fdds::SampleInfo& info) {
+  void add_status(const rsg::GatewayStatus& sample, const fdds::SampleInfo& info) {
     if (channels_.status == 0) return;
     ++statuses;
-    write(channels_.status, serializer_.serialize(sample), info);
+    add(channels_.status, serializer_.serialize(sample), info);
   }
-  void tick() { writer_->finish_chunk_if_older(now_ns()); }
+
+  /// Writes the batch in log time order. Each reader's samples come in the order DDS delivers them and
+  /// the status reader's are taken after the state reader's, so a batch is sorted first; a sample
+  /// stamped before one already written (taken a batch late, or a reliable reader's repaired sample,
+  /// delivered in sequence order after later ones) is logged at the latest log time written, since
+  /// MCAP readers expect log times never to go back (`mcap doctor` warns about every one that does).
+  void write_batch() {
+    std::stable_sort(batch_.begin(), batch_.end(),
+                     [](const Pending& a, const Pending& b) { return a.log_time < b.log_time; });
+    for (const Pending& pending : batch_) {
+      std::uint64_t log_time = pending.log_time;
+      if (log_time < last_log_time_) {
+        log_time = last_log_time_;
+        ++raised;
+      }
+      last_log_time_ = log_time;
+      write(pending.channel, pending.sequence, log_time, pending.publish_time,
+            std::span<const std::uint8_t>(batch_bytes_).subspan(pending.offset, pending.size));
+    }
+    batch_.clear();
+    batch_bytes_.clear();
+  }
+  void tick() {
+    if (writer_) writer_->finish_chunk_if_older(now_ns());
+  }
 
   /// Finishes the current file. Throws mcap::WriteError.
   void close() {
-    writer_->close();
-    add_totals();
+    write_batch();
+    if (writer_) finish_file();
   }
 
   std::uint64_t states = 0, statuses = 0;                                                    // received
   std::uint64_t messages = 0, chunks = 0, uncompressed = 0, compressed = 0, file_bytes = 0;  // written
   std::uint64_t syncs = 0, sync_ns = 0;                                                      // --fsync
+  std::uint64_t raised = 0;  // log times raised to the latest one written (write_batch)
   std::size_t files = 0;
 
  private:
@@ -105,6 +134,12 @@ class Recording {
     if (split_bytes_ != 0) std::cerr << "rsg_record: writing " << path.string() << "\n";
   }
 
+  void finish_file() {
+    writer_->close();
+    add_totals();
+    writer_.reset();
+  }
+
   void add_totals() {
     const auto& totals = writer_->totals();
     messages += totals.messages;
@@ -116,7 +151,14 @@ class Recording {
     sync_ns += totals.sync_ns;
   }
 
-  void write(std::uint16_t channel, std::span<const std::uint8_t> payload, const fdds::SampleInfo& info) {
+  struct Pending {
+    std::uint16_t channel;
+    std::uint32_t sequence;
+    std::uint64_t log_time, publish_time;
+    std::size_t offset, size;  // in batch_bytes_
+  };
+
+  void add(std::uint16_t channel, std::span<const std::uint8_t> payload, const fdds::SampleInfo& info) {
     // Log time: when DDS received the sample (not when a batch was taken); publish time: when the
     // gateway wrote it, the robot's frame timing that rsg_replay reproduces.
     const std::int64_t reception_time = info.reception_timestamp.to_ns();
@@ -124,11 +166,17 @@ class Recording {
     const std::int64_t source_time = info.source_timestamp.to_ns();
     const std::uint64_t publish_time = source_time > 0 ? static_cast<std::uint64_t>(source_time) : log_time;
     // The DDS sequence number (its low 32 bits) lets a reader of the file see gaps.
-    writer_->write(channel, info.sample_identity.sequence_number().low, log_time, publish_time, payload);
-    if (split_bytes_ != 0 && writer_->totals().file_bytes >= split_bytes_) {
-      close();
-      open();
-    }
+    batch_.push_back({channel, info.sample_identity.sequence_number().low, log_time, publish_time,
+                      batch_bytes_.size(), payload.size()});
+    batch_bytes_.insert(batch_bytes_.end(), payload.begin(), payload.end());
+  }
+
+  void write(std::uint16_t channel, std::uint32_t sequence, std::uint64_t log_time, std::uint64_t publish_time,
+             std::span<const std::uint8_t> payload) {
+    // After a split the next file is opened by the next message, so that none is left empty.
+    if (!writer_) open();
+    writer_->write(channel, sequence, log_time, publish_time, payload);
+    if (split_bytes_ != 0 && writer_->totals().file_bytes >= split_bytes_) finish_file();
   }
 
   const Options& options_;
@@ -137,6 +185,9 @@ class Recording {
   std::optional<rsg::mcap::Writer> writer_;
   rsg::record::Channels channels_;
   rsg::record::CdrSerializer serializer_;
+  std::vector<Pending> batch_;
+  std::vector<std::uint8_t> batch_bytes_;
+  std::uint64_t last_log_time_ = 0;
 };
 
 /// Counts samples the recorder never got: gaps in each writer's sequence numbers (meaningful
@@ -165,6 +216,10 @@ void add_options(CLI::App& app, Options& options) {
   app.add_option("--duration", options.duration_s,
                  "Stop after this many seconds (default: until SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--recover", options.recover,
+                 "Do not record: write what FILE (a recording whose recorder was killed) holds up to its last "
+                 "whole chunk to --out as a finished, indexed file, and exit")
+      ->check(CLI::ExistingFile);
   app.add_option("--split-size", options.split_mb,
                  "Start a new file when one reaches this many MB: FILE_0.mcap, FILE_1.mcap, ...")
       ->check(CLI::NonNegativeNumber);
@@ -177,6 +232,28 @@ void add_options(CLI::App& app, Options& options) {
                "fdatasync after every finished chunk and at the end, so that a power loss (not only a crash) "
                "keeps every finished chunk; costs one disk flush per chunk, each blocking the recorder for "
                "the disk's flush latency (the summary line reports the total)");
+}
+
+/// --recover: the damaged file's readable part, finished, in --out. Exit 0 when the file was
+/// truncated or whole, 1 when it is damaged inside (what came before the damage is still written).
+int recover(const Options& options) {
+  const rsg::mcap::MappedFile damaged(options.recover);
+  const auto result = rsg::mcap::recover(
+      damaged.bytes(), options.out, {.chunk_bytes = options.chunk_bytes, .sync = options.fsync});
+  using Status = rsg::mcap::ScanResult::Status;
+  std::cerr << "rsg_record: recovered " << result.written.messages << " messages in " << result.written.chunks
+            << " chunks from " << options.recover.string() << " into " << options.out.string();
+  if (result.unreadable > 0) std::cerr << "; left out " << result.unreadable << " on undescribed channels";
+  std::cerr << "\n";
+  if (result.scan.status == Status::truncated)
+    std::cerr << "rsg_record: " << options.recover.string() << " ends early (" << result.scan.error << " at byte "
+              << result.scan.offset << "): everything before it was recovered\n";
+  if (result.scan.status == Status::malformed) {
+    std::cerr << "rsg_record: " << options.recover.string() << " is damaged at byte " << result.scan.offset << ": "
+              << result.scan.error << "; what came before was recovered\n";
+    return kExitFailure;
+  }
+  return kExitOk;
 }
 
 int run(const Options& options, rsg::record::Profile profile) {
@@ -199,11 +276,12 @@ int run(const Options& options, rsg::record::Profile profile) {
     while (readers.state().take_next_sample(&state, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
       loss.add(info);
-      recording.write_state(state, info);
+      recording.add_state(state, info);
     }
     while (readers.status() != nullptr &&
            readers.status()->take_next_sample(&status, &info) == ReturnCode_t::RETCODE_OK)
-      if (info.valid_data) recording.write_status(status, info);
+      if (info.valid_data) recording.add_status(status, info);
+    recording.write_batch();
   };
   try {
     while (!readers.stop_requested() &&
@@ -233,6 +311,7 @@ int run(const Options& options, rsg::record::Profile profile) {
             << recording.statuses << " statuses"
             << "; dropped " << (options.view_profile.empty() ? loss.gaps : 0) << " (sequence gaps), "
             << lost.total_count << " (lost in DDS)";
+  if (recording.raised > 0) std::cerr << "; " << recording.raised << " log times raised to keep their order";
   if (options.fsync)
     std::cerr << "; " << recording.syncs << " fsyncs in " << static_cast<double>(recording.sync_ns) / 1e6
               << " ms";
@@ -246,10 +325,18 @@ int main(int argc, char** argv) {
   CLI::App app{"Records RobotState and GatewayStatus samples into an MCAP file.", "rsg_record"};
   app.footer(
       "Exit status: 0 after --duration or on SIGINT/SIGTERM (the file finished), 1 when the file cannot be "
-      "written (what was recorded stays readable) or DDS fails, 2 usage error.");
+      "written (what was recorded stays readable) or DDS fails, 2 usage error. --recover: 0 when FILE read to "
+      "its end or was cut off, 1 when it is damaged inside.");
   Options options;
   add_options(app, options);
   if (const auto stop = parse_command_line(app, argc, argv)) return *stop;
+  if (!options.recover.empty()) {
+    if (fs::exists(options.out) && fs::equivalent(options.out, options.recover)) {
+      std::cerr << "rsg_record: --recover writes a new file: --out must be another path\n";
+      return kExitUsage;
+    }
+    return run_reporting_errors("rsg_record", [&] { return recover(options); });
+  }
   const auto profile = rsg::record::parse_profile(options.profile);
   if (!profile) {
     std::cerr << "rsg_record: --profile must be omgidl or ros2, not '" << options.profile << "'\n";

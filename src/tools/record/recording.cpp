@@ -81,18 +81,28 @@ struct CdrSerializer::Types {
 
 CdrSerializer::CdrSerializer() : types_(std::make_unique<Types>()) {
   types_->payload.reserve(std::max(types_->robot_state.m_typeSize, types_->status.m_typeSize));
+  std::memset(types_->payload.data, 0, types_->payload.max_size);
+}
+
+// Fast CDR skips the padding before an aligned member without writing it, so a reused buffer would
+// carry the previous sample's bytes there: the same sample would not always give the same bytes
+// (found comparing a recovered file with another recorder's file of the same stream). Zeroing what
+// the previous sample wrote keeps padding 0, as a fresh buffer has it.
+void CdrSerializer::clear_payload() {
+  std::memset(types_->payload.data, 0, types_->payload.length);
+  types_->payload.length = 0;
 }
 
 CdrSerializer::~CdrSerializer() = default;
 
 std::span<const std::uint8_t> CdrSerializer::serialize(const RobotState& sample) {
-  types_->payload.length = 0;
+  clear_payload();
   if (!types_->robot_state.serialize(const_cast<RobotState*>(&sample), &types_->payload)) return {};
   return {types_->payload.data, types_->payload.length};
 }
 
 std::span<const std::uint8_t> CdrSerializer::serialize(const GatewayStatus& sample) {
-  types_->payload.length = 0;
+  clear_payload();
   if (!types_->status.serialize(const_cast<GatewayStatus*>(&sample), &types_->payload)) return {};
   return {types_->payload.data, types_->payload.length};
 }
@@ -100,6 +110,7 @@ std::span<const std::uint8_t> CdrSerializer::serialize(const GatewayStatus& samp
 bool CdrSerializer::deserialize(std::span<const std::uint8_t> bytes, RobotState& sample) {
   auto& payload = types_->payload;
   if (bytes.size() > payload.max_size) return false;
+  clear_payload();
   if (!bytes.empty()) std::memcpy(payload.data, bytes.data(), bytes.size());  // an empty span may be null
   payload.length = static_cast<std::uint32_t>(bytes.size());
   payload.pos = 0;

@@ -64,6 +64,8 @@ class CdrSerializer {
   bool deserialize(std::span<const std::uint8_t> bytes, RobotState& sample);
 
  private:
+  void clear_payload();
+
   struct Types;
   std::unique_ptr<Types> types_;
 };

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Go tools of the tests, from the Go module proxy, pinned by tools/deps/go/go.mod and go.sum:
+# $DEPS_DIR/bin/rsg-mcap-check, tools/deps/go/mcapcheck built on MCAP's own Go library
+# (github.com/foxglove/mcap/go/mcap). GOPATH, the module cache and the build cache live under
+# $DEPS_DIR, so nothing outside the project changes; the tool is built again only when
+# tools/deps/go/ changed. (The official `mcap` CLI module, github.com/foxglove/mcap/go/cli/mcap,
+# is not served by the proxy: docs/mcap-tested.md.)
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+deps_dir=${DEPS_DIR:-$PWD/.deps}
+go=${RSG_DEPS_GO:-$(command -v go || echo /usr/local/go/bin/go)}
+if [[ ! -x $go ]]; then
+  echo "make deps: no Go toolchain (go on PATH or /usr/local/go/bin/go) to build rsg-mcap-check" >&2
+  exit 1
+fi
+stamp=$(cat tools/deps/go/go.mod tools/deps/go/go.sum tools/deps/go/*/*.go | sha256sum | cut -d' ' -f1)
+bin=$deps_dir/bin/rsg-mcap-check
+[[ -x $bin && -f $bin.rsg-stamp && $(<"$bin.rsg-stamp") == "$stamp" ]] && exit 0
+echo "make deps: building $bin from tools/deps/go"
+mkdir -p "$deps_dir/bin"
+export GOPATH=$deps_dir/go GOMODCACHE=$deps_dir/go/pkg/mod GOCACHE=$deps_dir/go/cache
+export GOFLAGS=-mod=readonly GOTOOLCHAIN=local GOWORK=off CGO_ENABLED=0
+(cd tools/deps/go && "$go" build -trimpath -o "$bin" ./mcapcheck)
+echo "$stamp" > "$bin.rsg-stamp"
