@@ -6,4 +6,5 @@ cd "$(dirname "$0")/../.."
 image=${RSG_IMAGE:-rsg}
 docker/build-image.sh "$image"
 source docker/engine.sh
-exec python3 tests/image/test_image.py --engine "${ENGINE[*]}" --image "$image" "$@"
+# Debian's Python: its python3-yaml reads compose.yaml (make deps installs it).
+exec /usr/bin/python3 tests/image/test_image.py --engine "${ENGINE[*]}" --image "$image" "$@"

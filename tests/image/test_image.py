@@ -6,11 +6,14 @@ over loopback and the host's /dev/shm (what docker/compose.yaml sets).
                 to the values sent; the image's HEALTHCHECK passes on the running gateway
   view          rsg_view serves its page to Debian's headless Chromium on the host
                 (tests/view/check_page.mjs): live samples rsg_sim sent, plotted by Chart.js
-  restart       the gateway container killed (the Fast DDS 2.9.1 abort's effect) and run again, as
-                `restart: on-failure` does: the running echo and recorder resume, and every sample
-                the echo printed is one rsg_sim sent, in order
-  compose       docker/compose.yaml's services with podman-compose (docker compose with Docker):
-                the page on RSG_VIEW_PORT, the echo's samples, the recording in the volume
+  restart       the gateway container killed (`ENGINE kill`) and run again, as `restart: on-failure`
+                would, then its process killed from the host (a crash, the Fast DDS 2.9.1 abort's
+                effect) and restarted by the engine itself: the running echo and recorder resume,
+                and every sample the echo printed is one rsg_sim sent, in order
+  compose       docker/compose.yaml's services, run as the file says (docker compose with Docker;
+                with podman by compose_up, as Debian 12's podman-compose cannot run the file): the
+                gateway healthy, the echo's samples, the page on RSG_VIEW_PORT, the recording in the
+                volume read by the reference reader
 
     tests/image/run.sh          # builds the image first (make test-image)
     test_image.py --engine "podman --runtime runc" --image rsg [--case NAME]
@@ -19,6 +22,7 @@ over loopback and the host's /dev/shm (what docker/compose.yaml sets).
 import argparse
 import json
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -92,9 +96,22 @@ class Containers:
         self.names.add(name)
         return self.processes[label]
 
-    def gateway(self, port):
-        return self.start("gateway", "--listen", f"127.0.0.1:{port}", "--domain", self.domain,
-                          "--expected-rate", "500", mounts=[f"{self.stats_dir}:{STATS_DIR}"])
+    def gateway(self, port, label="gateway"):
+        return self.start(label, *self.gateway_args(port), mounts=[f"{self.stats_dir}:{STATS_DIR}"])
+
+    def gateway_args(self, port):
+        return ["--listen", f"127.0.0.1:{port}", "--domain", self.domain, "--expected-rate", "500"]
+
+    def detached_gateway(self, label, port):
+        """The gateway as compose runs it: detached, `--restart on-failure`."""
+        name = self.container(label)
+        self.names.add(name)
+        self.engine_run("run", "-d", "--name", name, "--restart", "on-failure", "--network", "host", "--ipc", "host",
+                        "-v", f"{self.stats_dir}:{STATS_DIR}", self.image, *map(str, self.gateway_args(port)))
+        return name
+
+    def inspect(self, name, template):
+        return self.engine_run("inspect", "--format", template, name).stdout.strip()
 
     def wait(self, label, timeout_s=60):
         try:
@@ -228,18 +245,32 @@ def view_and_restart(c):
     print(f"[image] view: the page showed {shown}", flush=True)
     check(c.stop("view") == 0, "rsg_view did not exit 0 on SIGTERM")
 
-    # The kill, then the gateway again with the same command (what `restart: on-failure` runs).
-    wait_for(lambda: len(read_json_lines(c.output("echo2"))) >= 200, "rsg_echo's first samples")
+    # The kill, then the gateway again with the same command, as `restart: on-failure` would: the
+    # engine does not restart a container it was told to kill, so the test runs it again.
+    def samples():
+        return len(read_json_lines(c.output("echo2")))
+
+    wait_for(lambda: samples() >= 200, "rsg_echo's first samples")
     c.engine_run("kill", c.container("gateway"))
     status = c.wait("gateway")
     check(status != 0, f"the killed gateway container exited {status}")
     time.sleep(1.0)
-    before = len(read_json_lines(c.output("echo2")))
+    before = samples()
     c.stats.unlink(missing_ok=True)
-    c.gateway(port)
+    gateway = c.detached_gateway("gateway2", port)
     wait_for_stats(c.stats, lambda s: s["frames_published"] > 0, "the gateway to publish again", timeout_s=60)
-    wait_for(lambda: len(read_json_lines(c.output("echo2"))) >= before + 500,
-             f"rsg_echo to resume ({before} samples before the kill)", timeout_s=60)
+    wait_for(lambda: samples() >= before + 500, f"rsg_echo to resume ({before} samples before the kill)",
+             timeout_s=60)
+
+    # A crash the engine did not order (the abort's effect: the process ends on a signal): SIGKILL
+    # from the host to the container's process. The engine itself starts it again (on-failure).
+    pid = c.inspect(gateway, "{{.State.Pid}}")
+    os.kill(int(pid), 9)
+    wait_for(lambda: c.inspect(gateway, "{{.RestartCount}}") not in ("", "0"), "the engine to restart the gateway",
+             timeout_s=60)
+    crashed = samples()
+    wait_for(lambda: samples() >= crashed + 500, f"rsg_echo to resume after the crash ({crashed} samples then)",
+             timeout_s=60)
     check(c.processes["echo2"].poll() is None and c.processes["record2"].poll() is None,
           "a reader exited when the gateway was killed")
     check(c.stop("sim2") == 0, f"rsg_sim did not exit 0 on SIGTERM: {c.stderr('sim2')}")
@@ -249,54 +280,92 @@ def view_and_restart(c):
 
     received = read_json_lines(c.output("echo2"))
     sent = read_json_lines(c.data / "sim2.jsonl")
-    check(len(received) >= before + 500, f"rsg_echo printed {len(received)} samples, {before} before the kill")
+    check(len(received) >= crashed + 500, f"rsg_echo printed {len(received)} samples, {crashed} before the crash")
     check(is_subsequence(received, sent), "rsg_echo printed a sample rsg_sim did not send, or out of order")
     seen = node("tests/record/check_recording.mjs", c.data / "restart.mcap")
-    check(seen["states"] >= before + 500, f"the recording holds {seen['states']} states, {before} before the kill")
-    print(f"[image] restart: {before} samples before the kill, {len(received)} in all, every one sent by "
-          f"rsg_sim, in order; the recording is readable ({seen['states']} states)", flush=True)
-    check(c.stop("gateway") == 0, "the gateway did not exit 0 on SIGTERM")
+    check(seen["states"] >= crashed + 500, f"the recording holds {seen['states']} states, {crashed} before the crash")
+    print(f"[image] restart: {before} samples before the kill, {crashed} before the crash, {len(received)} in "
+          f"all, every one sent by rsg_sim, in order; the recording is readable ({seen['states']} states)", flush=True)
+    c.engine_run("stop", "-t", "20", gateway, timeout_s=60)
+    check(c.inspect(gateway, "{{.State.ExitCode}}") == "0", "the gateway did not exit 0 on SIGTERM")
+
+
+# What the compose runner below understands of a service; any other key fails the test, so that
+# compose.yaml cannot grow a setting this test would silently leave out.
+COMPOSE_KEYS = {"image", "build", "network_mode", "ipc", "entrypoint", "command", "volumes", "restart", "depends_on"}
+
+
+def compose_services(path, env):
+    """docker/compose.yaml's services with ${VAR:-default} filled in from `env`, in start order."""
+    import yaml  # Debian's python3-yaml (make deps)
+    text = re.sub(r"\$\{(\w+):-([^}]*)\}", lambda m: env.get(m.group(1)) or m.group(2), path.read_text())
+    spec = yaml.safe_load(text)
+    services, ordered = spec["services"], []
+    while len(ordered) < len(services):
+        ready = [name for name, service in services.items() if name not in ordered
+                 and all(dep in ordered for dep in service.get("depends_on", []))]
+        check(ready, f"compose.yaml: depends_on has a cycle among {set(services) - set(ordered)}")
+        ordered += ready
+    for name in ordered:
+        unknown = set(services[name]) - COMPOSE_KEYS
+        check(not unknown, f"compose.yaml: service {name} uses {unknown}, which tests/image does not run")
+    return [(name, services[name]) for name in ordered], set(spec.get("volumes") or {})
+
+
+def compose_up(c, project, env):
+    """Runs compose.yaml's services as `compose up -d` does, with the engine itself: Debian 12's
+    podman-compose (1.0.3) passes no `ipc:` and adds a bridge network to `network_mode: host`
+    services, which podman refuses. Returns {service: container name}."""
+    services, volumes = compose_services(ROOT / "docker" / "compose.yaml", env)
+    for volume in volumes:
+        c.engine_run("volume", "create", f"{project}_{volume}")
+    names = {}
+    for name, service in services:
+        container = f"{project}_{name}_1"
+        names[name] = container
+        c.names.add(container)
+        args = ["run", "-d", "--name", container]
+        for key, flag in (("network_mode", "--network"), ("ipc", "--ipc"), ("restart", "--restart")):
+            if key in service:
+                args += [flag, service[key]]
+        for volume in service.get("volumes", []):
+            source, target = volume.split(":", 1)
+            args += ["-v", f"{project}_{source}:{target}" if source in volumes else volume]
+        if "entrypoint" in service:
+            entrypoint = service["entrypoint"]
+            args += ["--entrypoint", entrypoint[0] if len(entrypoint) == 1 else json.dumps(entrypoint)]
+        c.engine_run(*args, env.get("RSG_IMAGE", service["image"]), *service.get("command", []))
+    return names
 
 
 def compose(c):
-    """docker/compose.yaml as it is, on a domain and ports of this run, the image already built."""
-    if c.name == "podman":
-        tool = shutil.which("podman-compose")
-        check(tool is not None, "podman-compose is not installed: run `make deps`")
-        command = [tool]
-    else:
-        command = ["docker", "compose"]
+    """docker/compose.yaml, on a domain and ports of this run, the image already built: with
+    `docker compose` when the engine is Docker, else with compose_up."""
     project = c.prefix
     env = {**os.environ, "RSG_IMAGE": c.image, "RSG_DOMAIN": str(c.domain), "RSG_ROBOT_PORT": str(free_udp_port()),
            "RSG_VIEW_PORT": str(free_tcp_port())}
-    compose_file = ["-p", project, "-f", str(ROOT / "docker" / "compose.yaml")]
-
-    def run(*args, timeout_s=120):
-        result = subprocess.run([*command, *compose_file, *args], env=env, capture_output=True, text=True,
-                                timeout=timeout_s)
-        (c.dir / "compose.log").open("a").write(f"$ {' '.join(args)}\n{result.stdout}{result.stderr}\n")
-        check(result.returncode == 0, f"compose {' '.join(args)}: {result.stderr.strip()[-800:]}")
-        return result.stdout
+    docker_compose = ["docker", "compose", "-p", project, "-f", str(ROOT / "docker" / "compose.yaml")]
 
     def logs(service):
         result = c.engine_run("logs", names[service], check_status=False)
         return result.stdout + result.stderr
 
-    names = {}
     try:
-        run("up", "-d", "--no-build")
-        listed = c.engine_run("ps", "-a", "--format", "{{.Names}}").stdout.split()
-        for service in ("gateway", "sim", "echo", "record", "view"):
-            found = [name for name in listed if name in (f"{project}_{service}_1", f"{project}-{service}-1")]
-            check(found, f"compose started no {service} container: {listed}")
-            names[service] = found[0]
+        if c.name == "docker":
+            subprocess.run([*docker_compose, "up", "-d", "--no-build"], env=env, check=True, timeout=180)
+            names = {service: f"{project}-{service}-1" for service in ("gateway", "sim", "echo", "record", "view")}
+        else:
+            names = compose_up(c, project, env)
+        check(set(names) >= {"gateway", "sim", "echo", "record", "view"}, f"compose.yaml's services: {set(names)}")
         wait_for(lambda: healthy(c, names["gateway"]), "the gateway container to be healthy", timeout_s=60)
         wait_for(lambda: logs("echo").count('"fields"') >= 100, "rsg_echo's samples", timeout_s=60)
         url = f"http://127.0.0.1:{env['RSG_VIEW_PORT']}/"
         page = wait_for(lambda: fetch(url), f"rsg_view's page at {url}", timeout_s=60)
         check("<html" in page.lower(), f"{url} is not the page: {page[:200]}")
         time.sleep(2.0)
-        run("stop", "record")
+        c.engine_run("stop", "-t", "20", names["record"], timeout_s=60)
+        check(c.engine_run("inspect", "--format", "{{.State.ExitCode}}", names["record"]).stdout.strip() == "0",
+              f"rsg_record did not exit 0 on SIGTERM: {logs('record')[-500:]}")
         volume = c.engine_run("volume", "inspect", "--format", "{{.Mountpoint}}", f"{project}_recordings").stdout.strip()
         files = sorted(Path(volume).glob("robot*.mcap"))
         check(files, f"no recording in the volume ({volume})")
@@ -305,7 +374,12 @@ def compose(c):
         print(f"[image] compose: gateway healthy, echo printing, page at {url}, {files[0].name} in the volume "
               f"({seen['states']} states)", flush=True)
     finally:
-        subprocess.run([*command, *compose_file, "down", "-v"], env=env, capture_output=True, timeout=180)
+        if c.name == "docker":
+            subprocess.run([*docker_compose, "down", "-v"], env=env, capture_output=True, timeout=180)
+        else:
+            for container in [name for name in c.names if name.startswith(f"{project}_")]:
+                subprocess.run([*c.engine, "rm", "-f", "-t", "0", container], capture_output=True)
+            subprocess.run([*c.engine, "volume", "rm", "-f", f"{project}_recordings"], capture_output=True)
 
 
 def fetch(url):
