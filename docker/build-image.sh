@@ -17,7 +17,9 @@ if [[ $ENGINE_NAME == podman ]]; then
 fi
 start=$(date +%s)
 "${ENGINE[@]}" "${build[@]}"
-echo "image: built $image in $(( $(date +%s) - start )) s"
+# The CPU of this script's children: the base image (if made) and the build (with podman its RUN steps too).
+cpu=$(times | tail -n 1)
+echo "image: built $image in $(( $(date +%s) - start )) s, CPU (base image and build): ${cpu% *} user, ${cpu#* } system"
 # What the runtime stage adds to its base: the image's size less debian:bookworm-slim's.
 size() { "${ENGINE[@]}" image inspect --format '{{.Size}}' "$1"; }
 total=$(size "$image")
