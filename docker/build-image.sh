@@ -18,7 +18,10 @@ fi
 start=$(date +%s)
 "${ENGINE[@]}" "${build[@]}"
 # The CPU of this script's children: the base image (if made) and the build (with podman its RUN steps too).
-cpu=$(times | tail -n 1)
+cpu_file=$(mktemp)
+times > "$cpu_file"  # not in $(...): a subshell has no children
+cpu=$(tail -n 1 "$cpu_file")
+rm -f "$cpu_file"
 echo "image: built $image in $(( $(date +%s) - start )) s, CPU (base image and build): ${cpu% *} user, ${cpu#* } system"
 # What the runtime stage adds to its base: the image's size less debian:bookworm-slim's.
 size() { "${ENGINE[@]}" image inspect --format '{{.Size}}' "$1"; }
