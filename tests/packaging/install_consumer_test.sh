@@ -22,6 +22,10 @@ done
 cmake -S "$source_dir/tests/packaging/consumer" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" \
   > "$work/configure.log" || { cat "$work/configure.log"; exit 1; }
 cmake --build "$work/build" > "$work/build.log" 2>&1 || { cat "$work/build.log"; exit 1; }
+# ROS 2's default standard: the package's usage requirement lifts it to what the headers need.
+cmake -S "$source_dir/tests/packaging/consumer" -B "$work/build17" -DCMAKE_PREFIX_PATH="$work/prefix" \
+  -DCMAKE_CXX_STANDARD=17 > "$work/configure17.log" || { cat "$work/configure17.log"; exit 1; }
+cmake --build "$work/build17" > "$work/build17.log" 2>&1 || { cat "$work/build17.log"; exit 1; }
 "$work/build/consumer"
 # The embedded gateway from the installed package, with the installed profiles, on its own domain.
 "$work/build/embedded_consumer" "$work/prefix/share/rsg/xml_profiles" $(($$ % 200 + 10))
