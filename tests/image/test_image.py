@@ -4,9 +4,10 @@ over loopback and the host's /dev/shm (what docker/compose.yaml sets).
   pipeline      rsg_sim -> rsg_gateway -> rsg_echo --json and rsg_record: every frame exact at the
                 echo, the MCAP file read by the reference reader (tests/record/check_recording.mjs)
                 to the values sent; the image's HEALTHCHECK passes on the running gateway
-  view          rsg_view serves its page to Debian's headless Chromium on the host
-                (tests/view/check_page.mjs): live samples rsg_sim sent, plotted by Chart.js
-  restart       the gateway container killed (`ENGINE kill`) and run again, as `restart: on-failure`
+  view_and_restart
+                rsg_view serves its page to Debian's headless Chromium on the host
+                (tests/view/check_page.mjs): live samples rsg_sim sent, plotted by Chart.js; then
+                the gateway container killed (`ENGINE kill`) and run again, as `restart: on-failure`
                 would, then its process killed from the host (a crash, the Fast DDS 2.9.1 abort's
                 effect) and restarted by the engine itself: the running echo and recorder resume,
                 and every sample the echo printed is one rsg_sim sent, in order
@@ -35,13 +36,14 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "integration"))
-from harness import (TestFailure, check, free_udp_port, read_json, read_json_lines, test_domain,  # noqa: E402
-                     wait_for, wait_for_stats, wait_reader_matched)
+from harness import (TestFailure, check, free_udp_port, read_json_lines, wait_for, wait_for_stats,  # noqa: E402
+                     wait_reader_matched)
 
 SELECTIONS = ["--every", "1:q,dq,time", "--every", "3:g0", "--every", "10:all"]
 COUNT = 1000
 # Inside the image: the entrypoint's stats file (the HEALTHCHECK reads it) and where tests mount.
 STATS_DIR, DATA = "/run/rsg", "/data"
+IMAGE_UID = 10001  # the image's user (docker/Dockerfile)
 
 
 def free_tcp_port():
@@ -55,7 +57,7 @@ class Containers:
     """The containers of one run: each started attached (`ENGINE run --rm`), its stdout and stderr
     in LABEL.out / LABEL.err of the scratch directory, removed at the end whatever happened."""
 
-    def __init__(self, engine, image):
+    def __init__(self, engine, image, case):
         self.engine = shlex.split(engine)
         self.name = "podman" if "podman" in self.engine[0] else "docker"
         self.image = image
@@ -67,10 +69,13 @@ class Containers:
         for path in (self.data, self.stats_dir):
             path.chmod(0o777)
         self.stats = self.stats_dir / "gateway-stats.json"
-        self.domain = test_domain()
-        self.prefix = f"rsg-image-test-{os.getpid()}"
+        # Domains 210-230: none of ctest's (harness.test_domain: 10-209), one per case, so that no
+        # other test's gateway and no earlier case's writer is matched.
+        self.domain = 210 + os.getpid() % 7 * 3 + sorted(CASES).index(case)
+        self.prefix = f"rsg-image-test-{os.getpid()}-{case.replace('_', '-')}"
         self.processes = {}
         self.names = set()
+        self.started = time.time()
 
     def container(self, label):
         return f"{self.prefix}-{label}"
@@ -132,8 +137,19 @@ class Containers:
         return path.read_text(errors="replace") if path.exists() else ""
 
     def cleanup(self, keep):
-        for name in self.names:
-            subprocess.run([*self.engine, "rm", "-f", "-t", "0", name], capture_output=True)
+        # SIGTERM first: a tool stopped cleanly removes its shared-memory segments from /dev/shm.
+        if self.names:
+            subprocess.run([*self.engine, "stop", "-t", "10", *self.names], capture_output=True)
+            subprocess.run([*self.engine, "rm", "-f", *self.names], capture_output=True)
+        # What killed processes left in the host's /dev/shm (--ipc host): files of the image's user
+        # made during this run.
+        for path in Path("/dev/shm").glob("fast*"):
+            try:
+                info = path.stat()
+                if info.st_uid == IMAGE_UID and info.st_mtime >= self.started - 1:
+                    path.unlink()
+            except OSError:
+                pass
         for process in self.processes.values():
             if process.poll() is None:
                 process.kill()
@@ -216,7 +232,10 @@ def view_and_restart(c):
     wait_for_stats(c.stats, lambda s: True, "the gateway container to start", timeout_s=60)
     ws_port = free_tcp_port()
     c.start("view", "--domain", c.domain, "--listen", f"127.0.0.1:{ws_port}", entrypoint="rsg_view")
-    c.start("echo2", "--domain", c.domain, "--json", entrypoint="rsg_echo")
+    # The echo, a monitor that outlives gateway kills, uses no data-sharing (docs/operating.md: a
+    # writer killed while notifying a data-sharing reader can leave that reader's mutex locked); the
+    # recorder keeps its reliable default, as compose.yaml runs it.
+    c.start("echo2", "--domain", c.domain, "--json", "--qos", "reader_realtime_udp", entrypoint="rsg_echo")
     c.start("record2", "--domain", c.domain, "--out", f"{DATA}/restart.mcap", "--chunk-size", "65536",
             entrypoint="rsg_record")
     wait_for_stats(c.stats, lambda s: s["state_readers"] >= 3, "3 readers to match the gateway", timeout_s=60)
@@ -377,8 +396,10 @@ def compose(c):
         if c.name == "docker":
             subprocess.run([*docker_compose, "down", "-v"], env=env, capture_output=True, timeout=180)
         else:
-            for container in [name for name in c.names if name.startswith(f"{project}_")]:
-                subprocess.run([*c.engine, "rm", "-f", "-t", "0", container], capture_output=True)
+            containers = [name for name in c.names if name.startswith(f"{project}_")]
+            if containers:
+                subprocess.run([*c.engine, "stop", "-t", "10", *containers], capture_output=True)
+                subprocess.run([*c.engine, "rm", "-f", *containers], capture_output=True)
             subprocess.run([*c.engine, "volume", "rm", "-f", f"{project}_recordings"], capture_output=True)
 
 
@@ -401,7 +422,7 @@ def main():
     args = parser.parse_args()
     passed = failed = 0
     for name in args.case or list(CASES):
-        c = Containers(args.engine, args.image)
+        c = Containers(args.engine, args.image, name)
         ok = False
         start = time.monotonic()
         try:
