@@ -26,6 +26,21 @@ for list in docker/packages/{build,run,test}.txt; do
 done
 [[ ${#missing[@]} -eq 0 ]] || fail "listed but not installed: ${missing[*]}"
 
+# docker/runtime-packages.sh, which the image build runs on every tool: the packages of the libraries
+# a program loads (ldd prints /lib/..., dpkg may know /usr/lib/...), and a failure that names a
+# library no package owns.
+packages=$(docker/runtime-packages.sh /bin/ls) || fail "runtime-packages.sh /bin/ls failed"
+grep -qx libc6 <<< "$packages" || fail "runtime-packages.sh /bin/ls does not name libc6: $packages"
+scratch=$(mktemp -d)
+trap 'rm -rf "$scratch"' EXIT
+library=$(ldd /bin/ls | awk '$1 !~ /^(libc|linux-vdso)/ && $3 ~ /^\// { print $3; exit }')
+cp "$library" "$scratch/"
+if LD_LIBRARY_PATH=$scratch docker/runtime-packages.sh /bin/ls > /dev/null 2> "$scratch/err"; then
+  fail "runtime-packages.sh passed with $scratch/$(basename "$library"), which no package owns"
+fi
+grep -q "no Debian package owns $scratch/$(basename "$library")" "$scratch/err" ||
+  fail "runtime-packages.sh did not name the unowned library: $(cat "$scratch/err")"
+
 # The compose file runs binaries the image installs.
 for tool in $(grep -oE 'rsg_[a-z_]+' docker/compose.yaml | sort -u); do
   grep -q "$tool" CMakeLists.txt || fail "compose.yaml runs $tool, which is not installed"
