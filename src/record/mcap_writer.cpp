@@ -117,7 +117,8 @@ std::uint16_t Writer::add_schema(std::string_view name, std::string_view encodin
                                  std::span<const std::uint8_t> data) {
   const auto id = static_cast<std::uint16_t>(schemas_.size() + 1);
   schemas_.push_back({id, std::string(name), std::string(encoding), {data.begin(), data.end()}});
-  append_record(pending_, view(schemas_.back()));
+  append_record(chunk_, view(schemas_.back()));
+  chunk_definitions_.emplace_back(true, schemas_.size() - 1);
   return id;
 }
 
@@ -129,7 +130,8 @@ std::uint16_t Writer::add_channel(std::uint16_t schema_id, std::string_view topi
   const auto id = static_cast<std::uint16_t>(channels_.size() + 1);
   channels_.push_back({id, schema_id, std::string(topic), std::string(message_encoding), metadata});
   StringMap map;
-  append_record(pending_, view(channels_.back(), map));
+  append_record(chunk_, view(channels_.back(), map));
+  chunk_definitions_.emplace_back(false, channels_.size() - 1);
   chunk_index_.resize(id + 1);
   return id;
 }
@@ -189,7 +191,10 @@ void Writer::finish_chunk() {
   index.message_index_length = written_ + pending_.size() - indexes_start;
   write_pending();
 
-  // Only now is the chunk in the file: count it.
+  // Only now is the chunk in the file: count it (and the schemas and channels it carries).
+  for (const auto& [is_schema, index] : chunk_definitions_)
+    (is_schema ? schemas_[index].in_file : channels_[index].in_file) = true;
+  chunk_definitions_.clear();
   for (std::uint16_t id = 1; id < chunk_index_.size(); ++id) {
     channels_[id - 1].messages += chunk_index_[id].size();
     chunk_index_[id].clear();
@@ -241,6 +246,7 @@ void Writer::fail(const WriteError& error) {
   failing_ = true;
   pending_.clear();
   chunk_.clear();
+  chunk_definitions_.clear();
   chunk_messages_ = 0;
   for (auto& entries : chunk_index_) entries.clear();
   // Without room for the summary, a footer alone (50 bytes) still makes the file complete.
@@ -267,6 +273,16 @@ void Writer::fail(const WriteError& error) {
 }
 
 void Writer::write_summary_and_footer(bool with_summary) {
+  // Schemas and channels that no written chunk carries (no message came, or a write failed before
+  // their chunk was whole) go into the data section on their own: the summary repeats only what
+  // the data section has.
+  chunk_.clear();
+  chunk_definitions_.clear();
+  StringMap map;
+  for (auto& schema : schemas_)
+    if (!std::exchange(schema.in_file, true)) append_record(pending_, view(schema));
+  for (auto& channel : channels_)
+    if (!std::exchange(channel.in_file, true)) append_record(pending_, view(channel, map));
   write_pending();
   append_record(pending_, DataEnd{crc32(data_crc_, pending_)});
   if (!with_summary) {

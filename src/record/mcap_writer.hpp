@@ -7,8 +7,8 @@
 //   writer.write(channel, sequence, log_time_ns, publish_time_ns, cdr_bytes);
 //   writer.close();  // or let the destructor finish the file
 //
-// Crash safety: schemas and channels sit in the data section ahead of the chunks that use them,
-// and every finished chunk goes to the kernel at once (write(2)), so a writer killed with SIGKILL
+// Crash safety: a schema or channel goes into the open chunk, ahead of the messages that use it (as
+// MCAP's own writers do; `mcap recover` copies such chunks as they are), and every finished chunk goes to the kernel at once (write(2)), so a writer killed with SIGKILL
 // leaves a file that a reader scanning records front to back can read up to its last finished
 // chunk (with `sync`, a machine that loses power too). When a write fails (disk full, file size limit) the
 // file is cut back to its last whole record and, where the freed space allows, finished with a summary; the
@@ -97,12 +97,14 @@ class Writer {
     std::uint16_t id;
     std::string name, encoding;
     std::vector<std::uint8_t> data;
+    bool in_file = false;  ///< a chunk that carries it (or the data section itself) is in the file
   };
   struct OwnedChannel {
     std::uint16_t id, schema_id;
     std::string topic, message_encoding;
     std::vector<std::pair<std::string, std::string>> metadata;
     std::uint64_t messages = 0;
+    bool in_file = false;
   };
   class File;
   struct Compressor;
@@ -127,6 +129,7 @@ class Writer {
 
   // The open chunk: its records, and per channel the (log_time, offset) of each message in it.
   std::vector<std::uint8_t> chunk_;
+  std::vector<std::pair<bool, std::size_t>> chunk_definitions_;  // (schema?, index): what the open chunk carries
   std::vector<TimeOffsets> chunk_index_;  // indexed by channel id
   std::uint64_t chunk_start_ = 0, chunk_end_ = 0;
   std::uint64_t chunk_messages_ = 0;

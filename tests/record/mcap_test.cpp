@@ -14,6 +14,7 @@
 #include <numeric>
 
 #include "mcap_reader.hpp"
+#include "mcap_recover.hpp"
 #include "mcap_writer.hpp"
 
 namespace rsg::mcap {
@@ -179,6 +180,38 @@ TEST_F(McapTest, EveryCutOfTheFileReadsUpToItsLastWholeChunk) {
     ASSERT_EQ(seen.messages.size(), expected) << "cut at " << cut;
     for (std::size_t i = 0; i < seen.messages.size(); ++i) ASSERT_EQ(seen.messages[i].second, payload(i));
   }
+}
+
+// rsg_record --recover: a file cut anywhere (what SIGKILL leaves) becomes a finished file, with the
+// original header, holding exactly the messages a scan reads of the cut file.
+TEST_F(McapTest, RecoverFinishesAFileCutAnywhere) {
+  {
+    Writer writer(path, {.profile = "ros2", .library = "test", .chunk_bytes = 4096});
+    write_recording(writer);
+    writer.close();
+  }
+  const auto file = read_file(path);
+  const fs::path out = path.string() + ".recovered";
+  for (std::size_t cut = 60; cut < file.size(); cut += 997) {
+    Collected damaged;
+    const ScanResult damaged_scan = scan(std::span(file).first(cut), damaged);
+    const RecoverResult result = recover(std::span(file).first(cut), out, {.chunk_bytes = 8192});
+    EXPECT_EQ(result.scan.status, damaged_scan.status) << "cut at " << cut;
+    EXPECT_EQ(result.written.messages, damaged.messages.size()) << "cut at " << cut;
+    const auto recovered = read_file(out);
+    struct HeaderSeen : Collected {
+      std::string profile, library;
+      void on_header(const Header& header) override { profile = header.profile, library = header.library; }
+    } header;
+    ASSERT_EQ(scan(recovered, header).status, ScanResult::Status::complete) << "cut at " << cut;
+    EXPECT_EQ(header.profile, "ros2");
+    EXPECT_EQ(header.library, "test");
+    EXPECT_EQ(header.messages, damaged.messages) << "cut at " << cut;
+    EXPECT_EQ(header.topics, damaged.topics) << "cut at " << cut;
+    // Finished: it ends with the magic after a footer.
+    EXPECT_TRUE(std::equal(std::begin(kMagic), std::end(kMagic), recovered.end() - 8));
+  }
+  fs::remove(out);
 }
 
 // Disk full, simulated with a file size limit (the kernel refuses writes past it with EFBIG): the

@@ -242,6 +242,15 @@ def files(h):
     messages = python_reader(recovered)
     check(summary["profile"] == "ros2" and summary["messages"] == whole == len(messages) and whole > 300,
           f"the recovered file holds {summary['messages']} messages, --recover said {whole}: {summary}")
+    cli = os.environ.get("RSG_MCAP_CLI")
+    if cli:  # the official `mcap recover` makes a file `mcap doctor` accepts too
+        official = h.dir / "recovered_by_mcap.mcap"
+        result = subprocess.run([cli, "recover", str(out["killed"]), "-o", str(official)], capture_output=True,
+                                text=True, timeout=60)
+        print(f"[{h.name}] mcap recover: {result.stdout.strip()} {result.stderr.strip()}", flush=True)
+        check(result.returncode == 0 and f"Recovered {whole} messages" in result.stderr,
+              f"mcap recover: {result.stderr.strip()}")
+        doctor(h, official)
     # The recovered messages are the killed recording's first ones, byte for byte.
     with open(out["ros2_small"], "rb") as stream:
         full = [bytes(m.data) for _, c, m in SeekingReader(stream).iter_messages(log_time_order=False)

@@ -101,6 +101,13 @@ class Recording {
     if (writer_) writer_->finish_chunk_if_older(now_ns());
   }
 
+  /// After a WriteError: the writer ended the file as well as it could; count what it holds.
+  void count_failed_file() {
+    if (!writer_) return;
+    add_totals();
+    writer_.reset();
+  }
+
   /// Finishes the current file. Throws mcap::WriteError.
   void close() {
     write_batch();
@@ -297,6 +304,7 @@ int run(const Options& options, rsg::record::Profile profile) {
     recording.close();
   } catch (const rsg::mcap::WriteError& error) {
     std::cerr << "rsg_record: " << error.what() << "\n";
+    recording.count_failed_file();
     exit_code = kExitFailure;
   }
 
