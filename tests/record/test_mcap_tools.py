@@ -15,6 +15,7 @@ rosbags wrote. The tools come from `make deps` (nothing is fetched here):
 import json
 import os
 import re
+import resource
 import signal
 import subprocess
 import sys
@@ -137,16 +138,31 @@ def check_file(h, path, states, statuses=None, profile=""):
 
 # --- Recording.
 
-def recorder(h, label, out, *flags):
-    return h.start(label, [h.binary("rsg_record"), "--domain", str(h.domain), "--out", str(out), *flags])
+def recorder(h, label, out, *flags, file_limit=None):
+    """rsg_record started as `label`; with file_limit, on a disk that is full at that many bytes (a file
+    size limit: the kernel refuses writes past it)."""
+    argv = [h.binary("rsg_record"), "--domain", str(h.domain), "--out", str(out), *flags]
+    if file_limit is None:
+        return h.start(label, argv)
+
+    def limit_file_size():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (file_limit, file_limit))
+
+    print(f"[{h.name}] start {label} (files of at most {file_limit} bytes): {' '.join(argv)}", flush=True)
+    process = subprocess.Popen(argv, stdout=open(h.dir / f"{label}.out", "wb"), stderr=open(h.dir / f"{label}.err", "wb"),
+                               preexec_fn=limit_file_size)
+    h.children.append((label, process))
+    return process
 
 
-def record(h, recorders, count, rate=1000):
+def record(h, recorders, count, rate=1000, limits={}):
     """A gateway, the recorders {label: (file, flags)} matched to it, and rsg_sim sending `count`
     frames; returns (the running recorders, sim's record file, the gateway)."""
     port = free_udp_port()
     gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000")
-    running = {label: recorder(h, label, out, *flags) for label, (out, flags) in recorders.items()}
+    running = {label: recorder(h, label, out, *flags, file_limit=limits.get(label))
+               for label, (out, flags) in recorders.items()}
     wait_matched(h, stats, list(running), "rsg_record")
     sent = h.dir / "sim.record.jsonl"
     sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", str(rate), "--count", str(count),
@@ -190,11 +206,13 @@ def check_state(state, frame, where):
 
 def files(h):
     """Every kind of file rsg_record writes, from one stream: the default (omgidl, 1 MiB zstd chunks),
-    --profile ros2 (default and 64 KiB chunks), --split-size files, a --view recording, and a file
-    whose recorder was killed with SIGKILL, recovered with rsg_record --recover; each passes doctor
-    with no error or warning, and info and the Python reader count what was recorded."""
+    --profile ros2 (default and 64 KiB chunks), --split-size files, a --view recording, the file of a
+    recorder whose disk filled up, and a file whose recorder was killed with SIGKILL, recovered with
+    rsg_record --recover (and with `mcap recover` when RSG_MCAP_CLI is set); each passes doctor with no
+    error or warning, and info and the Python reader count what was recorded."""
     count = 1500
-    out = {name: h.dir / f"{name}.mcap" for name in ("default", "ros2", "ros2_small", "split", "view", "killed")}
+    out = {name: h.dir / f"{name}.mcap" for name in ("default", "ros2", "ros2_small", "split", "view", "killed",
+                                                     "full")}
     recorders = {
         "default": (out["default"], []),
         "ros2": (out["ros2"], ["--profile", "ros2"]),
@@ -202,15 +220,30 @@ def files(h):
         "split": (out["split"], ["--split-size", "0.15"]),
         "view": (out["view"], ["--view", "view_poses", "--status-topic", ""]),
         "killed": (out["killed"], ["--profile", "ros2", "--chunk-size", "65536"]),
+        "full": (out["full"], ["--chunk-size", "65536"]),
     }
-    running, sim, sent, stats, gateway = record(h, recorders, count)
+    running, sim, sent, stats, gateway = record(h, recorders, count, limits={"full": 250_000})
+    full = running.pop("full")
     # Killed halfway: some chunks are whole, the last one is cut or not begun.
     killed = running.pop("killed")
     wait_for(lambda: out["killed"].stat().st_size > 150_000, "finished chunks in the file to kill")
     killed.send_signal(signal.SIGKILL)
     killed.wait()
     check(h.wait("sim", sim, 30) == 0, "rsg_sim failed")
+    check(h.wait("full", full, 20) == 1, "rsg_record did not exit 1 on a full disk")
     stop_all(h, running, stats, count, gateway)
+
+    # The disk filled up: the file was finished with a summary, or (no room left for one) without.
+    err = (h.dir / "full.err").read_text()
+    check("File too large" in err and "the file was finished" in err, f"full disk: {err}")
+    doctor(h, out["full"])
+    if "finished without an index" in err:
+        with open(out["full"], "rb") as stream:
+            states = sum(c.topic == "robot_state" for _, c, _ in NonSeekingReader(stream, validate_crcs=True).iter_messages())
+    else:
+        states = next(c["messages"] for c in info(h, out["full"])["channels"] if c["topic"] == "robot_state")
+        python_reader(out["full"])
+    check(100 < states < count, f"the file of the full disk holds {states} states")
 
     check_file(h, out["default"], count, statuses=1)
     check_file(h, out["ros2"], count, statuses=1, profile="ros2")
