@@ -137,10 +137,7 @@ class Containers:
         return path.read_text(errors="replace") if path.exists() else ""
 
     def cleanup(self, keep):
-        # SIGTERM first: a tool stopped cleanly removes its shared-memory segments from /dev/shm.
-        if self.names:
-            subprocess.run([*self.engine, "stop", "-t", "10", *self.names], capture_output=True)
-            subprocess.run([*self.engine, "rm", "-f", *self.names], capture_output=True)
+        remove_containers(self.engine, self.names)
         # What killed processes left in the host's /dev/shm (--ipc host): files of the image's user
         # made during this run.
         for path in Path("/dev/shm").glob("fast*"):
@@ -165,6 +162,18 @@ class Containers:
             if lines:
                 print(f"--- {label}.err (last 20 lines)")
                 print("\n".join(line[:300] for line in lines[-20:]))
+
+
+def remove_containers(engine, names):
+    """Stops (SIGTERM first: a tool stopped cleanly removes its segments from /dev/shm) and removes
+    the containers, one engine call each: a call naming a container that is gone already (`run
+    --rm`) fails whole, leaving the others running."""
+    stops = [subprocess.Popen([*engine, "stop", "-t", "10", name], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL) for name in names]
+    for stop in stops:
+        stop.wait()
+    for name in names:
+        subprocess.run([*engine, "rm", "-f", name], capture_output=True)
 
 
 def node(script, *args, timeout_s=90):
@@ -396,10 +405,7 @@ def compose(c):
         if c.name == "docker":
             subprocess.run([*docker_compose, "down", "-v"], env=env, capture_output=True, timeout=180)
         else:
-            containers = [name for name in c.names if name.startswith(f"{project}_")]
-            if containers:
-                subprocess.run([*c.engine, "stop", "-t", "10", *containers], capture_output=True)
-                subprocess.run([*c.engine, "rm", "-f", *containers], capture_output=True)
+            remove_containers(c.engine, [name for name in c.names if name.startswith(f"{project}_")])
             subprocess.run([*c.engine, "volume", "rm", "-f", f"{project}_recordings"], capture_output=True)
 
 
@@ -435,6 +441,12 @@ def main():
             c.cleanup(keep=not ok)
         print(f"[image.{name}] {'passed' if ok else 'FAILED'} in {time.monotonic() - start:.0f} s", flush=True)
         passed, failed = passed + ok, failed + (not ok)
+        listed = subprocess.run([*c.engine, "ps", "-a", "--format", "{{.Names}}"], capture_output=True, text=True)
+        left = [container for container in listed.stdout.split() if container.startswith(c.prefix)]
+        if left:
+            print(f"[image.{name}] FAILED: containers left behind: {left}")
+            remove_containers(c.engine, left)
+            passed, failed = passed - ok, failed + ok
     print(f"image: {passed} passed, {failed} failed")
     return 0 if failed == 0 else 1
 
