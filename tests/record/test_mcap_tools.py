@@ -415,4 +415,7 @@ def rosbags_replay(h):
 CASES = {f.__name__: f for f in (files, ros2_decode, rosbags_replay)}
 
 if __name__ == "__main__":
+    if not CHECKER.exists():
+        print(f"[mcap_tools_{CASE}] FAILED: {CHECKER} is missing: run `make deps` (tools/deps/go.sh)", flush=True)
+        sys.exit(1)
     sys.exit(main(f"mcap_tools_{CASE}", CASES[CASE]))
