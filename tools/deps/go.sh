@@ -19,6 +19,6 @@ bin=$deps_dir/bin/rsg-mcap-check
 echo "make deps: building $bin from tools/deps/go"
 mkdir -p "$deps_dir/bin"
 export GOPATH=$deps_dir/go GOMODCACHE=$deps_dir/go/pkg/mod GOCACHE=$deps_dir/go/cache
-export GOFLAGS=-mod=readonly GOTOOLCHAIN=local GOWORK=off CGO_ENABLED=0
+export GOFLAGS="-mod=readonly -buildvcs=false" GOTOOLCHAIN=local GOWORK=off CGO_ENABLED=0
 (cd tools/deps/go && "$go" build -trimpath -o "$bin" ./mcapcheck)
 echo "$stamp" > "$bin.rsg-stamp"
