@@ -100,24 +100,30 @@ func (d *doctor) schema(s *mcap.Schema) {
 	if s.Encoding == "" && len(s.Data) == 0 {
 		d.warnf("schema %d (%q) has neither encoding nor data", s.ID, s.Name)
 	}
+	define(d, "schema", s.ID, s, d.schemas, d.summarySchemas)
+}
+
+// define records a schema or channel: one in the summary must repeat the data section's, one written
+// twice in the data section must be the same (a warning even then, as `mcap doctor` gives).
+func define[T any](d *doctor, kind string, id uint16, record *T, data, summary map[uint16]*T) {
+	previous := data[id]
 	if d.inSummary {
-		previous := d.schemas[s.ID]
 		if previous == nil {
-			d.errorf("schema %d is in the summary but not in the data section", s.ID)
-		} else if !reflect.DeepEqual(previous, s) {
-			d.errorf("schema %d in the summary differs from the data section's", s.ID)
+			d.errorf("%s %d is in the summary but not in the data section", kind, id)
+		} else if !reflect.DeepEqual(previous, record) {
+			d.errorf("%s %d in the summary differs from the data section's", kind, id)
 		}
-		d.summarySchemas[s.ID] = s
+		summary[id] = record
 		return
 	}
-	if previous := d.schemas[s.ID]; previous != nil {
-		if !reflect.DeepEqual(previous, s) {
-			d.errorf("two different schema records with id %d", s.ID)
+	if previous != nil {
+		if !reflect.DeepEqual(previous, record) {
+			d.errorf("two different %s records with id %d", kind, id)
 		} else {
-			d.warnf("schema %d is written twice in the data section", s.ID)
+			d.warnf("%s %d is written twice in the data section", kind, id)
 		}
 	}
-	d.schemas[s.ID] = s
+	data[id] = record
 }
 
 func (d *doctor) channel(c *mcap.Channel) {
@@ -128,24 +134,7 @@ func (d *doctor) channel(c *mcap.Channel) {
 	if c.SchemaID != 0 && d.schemas[c.SchemaID] == nil {
 		d.errorf("channel %d (%s) names schema %d, which comes later or never", c.ID, c.Topic, c.SchemaID)
 	}
-	if d.inSummary {
-		previous := d.channels[c.ID]
-		if previous == nil {
-			d.errorf("channel %d is in the summary but not in the data section", c.ID)
-		} else if !reflect.DeepEqual(previous, c) {
-			d.errorf("channel %d in the summary differs from the data section's", c.ID)
-		}
-		d.summaryChans[c.ID] = c
-		return
-	}
-	if previous := d.channels[c.ID]; previous != nil {
-		if !reflect.DeepEqual(previous, c) {
-			d.errorf("two different channel records with id %d", c.ID)
-		} else {
-			d.warnf("channel %d is written twice in the data section", c.ID)
-		}
-	}
-	d.channels[c.ID] = c
+	define(d, "channel", c.ID, c, d.channels, d.summaryChans)
 }
 
 func (d *doctor) message(m *mcap.Message) {
