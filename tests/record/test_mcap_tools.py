@@ -368,8 +368,13 @@ def rosbags_replay(h):
     typestore = get_typestore(Stores.EMPTY)
     typestore.register(get_types_from_msg((MSG_DIR / "RobotState.msg").read_text(), STATE_TYPE))
     with BagReader(path) as bag:
-        decoded = [(timestamp, typestore.deserialize_cdr(raw, STATE_TYPE)) for _, timestamp, raw in bag.messages()]
+        raws = [(timestamp, bytes(raw)) for _, timestamp, raw in bag.messages()]
+    decoded = [(timestamp, typestore.deserialize_cdr(raw, STATE_TYPE)) for timestamp, raw in raws]
     check(len(decoded) == count, f"rosbags read {len(decoded)} states")
+    # rosbags' serializer gives the very bytes rsg_record wrote (padding included).
+    for index, ((_, raw), (_, message)) in enumerate(zip(raws, decoded)):
+        check(bytes(typestore.serialize_cdr(message, STATE_TYPE)) == raw,
+              f"state {index}: rosbags serializes it to other bytes than rsg_record wrote")
 
     for mode in (CompressionMode.NONE, CompressionMode.STORAGE):
         bag_dir = h.dir / f"bag_{mode.name.lower()}"
