@@ -5,9 +5,10 @@
 #include <fastrtps/utils/IPLocator.h>
 #include <netdb.h>
 
-#include <charconv>
 #include <memory>
 #include <stdexcept>
+
+#include "rsg/wire/number.hpp"
 
 namespace rsg {
 namespace {
@@ -15,18 +16,10 @@ namespace {
 using eprosima::fastrtps::rtps::IPLocator;
 using eprosima::fastrtps::rtps::Locator_t;
 
-// The gateway's participant ids (src/gateway/gateway.cpp: pid modulo 60).
-constexpr std::uint32_t kPeerParticipantIds = 60;
-
 struct HostPort {
   std::string host;
   unsigned port = 0;  // 0: none given
 };
-
-bool parse_number(std::string_view text, unsigned& out) {
-  const auto [end, status] = std::from_chars(text.data(), text.data() + text.size(), out);
-  return !text.empty() && status == std::errc() && end == text.data() + text.size();
-}
 
 // "HOST:PORT", or "HOST" when the port is optional. Returns what is wrong, or "".
 std::string split_host_port(const std::string& value, bool port_required, HostPort& out) {
@@ -38,8 +31,8 @@ std::string split_host_port(const std::string& value, bool port_required, HostPo
   }
   out.host = value.substr(0, colon);
   if (out.host.empty()) return "'" + value + "' has no HOST";
-  if (!parse_number(std::string_view(value).substr(colon + 1), out.port) || out.port == 0 || out.port > 65535)
-    return "'" + value + "': port must be a number 1..65535";
+  out.port = parse_number<unsigned>(std::string_view(value).substr(colon + 1)).value_or(0);
+  if (out.port == 0 || out.port > 65535) return "'" + value + "': port must be a number 1..65535";
   return {};
 }
 
@@ -47,8 +40,9 @@ std::string split_host_port(const std::string& value, bool port_required, HostPo
 std::string split_server(const std::string& value, unsigned& id, HostPort& out) {
   std::string host_port = value;
   if (const std::size_t at = value.find('@'); at != std::string::npos) {
-    if (!parse_number(std::string_view(value).substr(0, at), id) || id > 255)
-      return "'" + value + "': server id before '@' must be 0..255";
+    const std::optional<unsigned> given = parse_number<unsigned>(std::string_view(value).substr(0, at));
+    if (!given || *given > 255) return "'" + value + "': server id before '@' must be 0..255";
+    id = *given;
     host_port = value.substr(at + 1);
   }
   return split_host_port(host_port, /*port_required=*/true, out);
@@ -128,7 +122,7 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
       builtin.initialPeersList.push_back(udp_locator(address, peer.port));
       continue;
     }
-    for (std::uint32_t id = 0; id < kPeerParticipantIds; ++id)
+    for (std::uint32_t id = 0; id < kGatewayParticipantIds; ++id)
       builtin.initialPeersList.push_back(
           udp_locator(address, ports.portBase + ports.domainIDGain * static_cast<std::uint32_t>(domain) +
                                    ports.offsetd1 + ports.participantIDGain * id));

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "rsg/dds/ros2.hpp"
+#include "rsg/wire/number.hpp"
 #include "source_filter.hpp"
 
 namespace rsg::gateway {
@@ -25,10 +26,8 @@ std::string check_host_port(const std::string& value, bool allow_port_zero) {
   const std::size_t colon = value.rfind(':');
   if (colon == std::string::npos || colon == 0) return "'" + value + "' is not HOST:PORT";
   const std::string_view port = std::string_view(value).substr(colon + 1);
-  unsigned number = 0;
-  const auto [end, status] = std::from_chars(port.data(), port.data() + port.size(), number);
-  if (port.empty() || status != std::errc() || end != port.data() + port.size() || number > 65535 ||
-      (number == 0 && !allow_port_zero))
+  const std::optional<unsigned> number = parse_number<unsigned>(port);
+  if (!number || *number > 65535 || (*number == 0 && !allow_port_zero))
     return "'" + value + "': port must be a number " + (allow_port_zero ? "0" : "1") + "..65535";
   return {};
 }
@@ -44,10 +43,8 @@ std::string check_not_empty(const std::string& value) { return value.empty() ? "
 std::string check_discovery_server(const std::string& value) {
   const std::size_t at = value.find('@');
   if (at == std::string::npos) return check_host_port(value, false);
-  unsigned id = 0;
-  const auto [end, status] = std::from_chars(value.data(), value.data() + at, id);
-  if (at == 0 || status != std::errc() || end != value.data() + at || id > 255)
-    return "'" + value + "': server id before '@' must be 0..255";
+  const std::optional<unsigned> id = parse_number<unsigned>(std::string_view(value).substr(0, at));
+  if (!id || *id > 255) return "'" + value + "': server id before '@' must be 0..255";
   return check_host_port(value.substr(at + 1), false);
 }
 
@@ -269,9 +266,9 @@ std::string known_keys() {
 template <class Number>
 std::string read_number(const YAML::Node& node, Number& out) {
   const std::string& text = node.Scalar();
-  const auto [end, status] = std::from_chars(text.data(), text.data() + text.size(), out);
-  if (text.empty() || status != std::errc() || end != text.data() + text.size())
-    return "'" + text + "' is not " + (std::is_integral_v<Number> ? "an integer" : "a number");
+  const std::optional<Number> number = parse_number<Number>(text);
+  if (!number) return "'" + text + "' is not " + (std::is_integral_v<Number> ? "an integer" : "a number");
+  out = *number;
   return {};
 }
 
@@ -397,18 +394,13 @@ std::optional<Decimation> parse_decimation(const std::string& value) {
   constexpr std::string_view kEvery = "every:";
   if (value.starts_with(kEvery)) {
     const std::string_view n = std::string_view(value).substr(kEvery.size());
-    std::uint32_t every = 0;
-    const auto [end, status] = std::from_chars(n.data(), n.data() + n.size(), every);
-    if (n.empty() || status != std::errc() || end != n.data() + n.size() || every < 1 || every > 1'000'000)
-      return std::nullopt;
-    return Decimation{every, {}};
+    const std::optional<std::uint32_t> every = parse_number<std::uint32_t>(n);
+    if (!every || *every < 1 || *every > 1'000'000) return std::nullopt;
+    return Decimation{*every, {}};
   }
-  double hz = 0;
-  const auto [end, status] = std::from_chars(value.data(), value.data() + value.size(), hz);
-  if (value.empty() || status != std::errc() || end != value.data() + value.size() ||
-      !(hz > 0 && hz <= 10000))
-    return std::nullopt;
-  return Decimation{0, std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / hz))};
+  const std::optional<double> hz = parse_number<double>(value);
+  if (!hz || !(*hz > 0 && *hz <= 10000)) return std::nullopt;
+  return Decimation{0, std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / *hz))};
 }
 
 Selection requested_selection(const GatewayConfig& config) {

@@ -68,15 +68,16 @@ void load_and_check_profiles(const GatewayConfig& config) {
 // A gateway restarted after a crash must not come back on its predecessor's ports: readers still
 // hold the dead participant's state for those locators, and resumed only after 1.6-20 s in
 // tests/reliability/test_gateway_restart.py. A participant id taken from the pid gives a restart
-// other ports (Fast DDS moves on to free ports if these are taken). 60 ids keep every domain's
-// ports below 65536. A profile that sets <participantID> itself is left alone.
+// other ports (Fast DDS moves on to free ports if these are taken). A profile that sets <participantID>
+// itself is left alone.
 fdds::DomainParticipantQos participant_qos(const GatewayConfig& config) {
   const std::string& profile = config.participant_profile;
   fdds::DomainParticipantQos qos;
   if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(profile, qos) !=
       ReturnCode_t::RETCODE_OK)
     throw std::runtime_error("no participant profile named '" + profile + "'");
-  if (qos.wire_protocol().participant_id < 0) qos.wire_protocol().participant_id = ::getpid() % 60;
+  if (qos.wire_protocol().participant_id < 0)
+    qos.wire_protocol().participant_id = static_cast<std::int32_t>(::getpid() % kGatewayParticipantIds);
   try {
     apply_discovery({config.discovery_servers, config.peers}, config.domain, qos);
   } catch (const std::invalid_argument& error) {

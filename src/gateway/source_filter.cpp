@@ -3,9 +3,10 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 
-#include <charconv>
 #include <cstring>
 #include <optional>
+
+#include "rsg/wire/number.hpp"
 
 namespace rsg::gateway {
 namespace {
@@ -60,8 +61,9 @@ std::optional<ParsedNetwork> parse_network(std::string_view text, std::string& e
   unsigned bits = max_bits;
   if (slash != std::string_view::npos) {
     const std::string_view prefix = text.substr(slash + 1);
-    const auto [end, status] = std::from_chars(prefix.data(), prefix.data() + prefix.size(), bits);
-    if (prefix.empty() || status != std::errc() || end != prefix.data() + prefix.size() || bits > max_bits) {
+    const std::optional<unsigned> number = parse_number<unsigned>(prefix);
+    if (number) bits = *number;
+    if (!number || bits > max_bits) {
       error = "'" + std::string(text) + "': prefix must be a number 0.." + std::to_string(max_bits);
       return std::nullopt;
     }

@@ -3,6 +3,7 @@
 #include <charconv>
 
 #include "group_bytes.hpp"
+#include "rsg/wire/number.hpp"
 
 namespace rsg {
 namespace {
@@ -25,13 +26,12 @@ bool for_each_item(std::string_view list, std::string& error, OnItem&& on_item) 
 }
 
 bool parse_group(std::string_view item, std::size_t& group, std::string& error) {
-  unsigned value = 0;
-  const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
-  if (ec != std::errc{} || end != item.data() + item.size() || value >= kGroupCount) {
+  const std::optional<unsigned> value = parse_number<unsigned>(item);
+  if (!value || *value >= kGroupCount) {
     error = "'" + std::string(item) + "' is not a group number 0..5";
     return false;
   }
-  group = value;
+  group = *value;
   return true;
 }
 

@@ -13,11 +13,16 @@
 // get_server_client_default_guidPrefix), so nothing else has to be copied between machines.
 #pragma once
 
+#include <cstdint>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <string>
 #include <vector>
 
 namespace rsg {
+
+/// How many participant ids the gateway picks from (its pid modulo this), and so how many ports
+/// a bare-HOST peer is tried on: 60 keeps every domain's ports below 65536.
+inline constexpr std::uint32_t kGatewayParticipantIds = 60;
 
 struct DiscoveryOptions {
   /// Discovery Servers, "[ID@]HOST:PORT": the participant becomes their CLIENT and sends no

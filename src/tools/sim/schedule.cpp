@@ -1,6 +1,6 @@
 #include "schedule.hpp"
 
-#include <charconv>
+#include "rsg/wire/number.hpp"
 
 namespace rsg::sim {
 namespace {
@@ -21,11 +21,10 @@ bool parse_item(std::string_view item, Selection& selection, std::string& error)
     return true;
   }
   // No field name starts with "g" followed by a digit, so group tokens cannot shadow a field.
-  unsigned group = 0;
   if (item.size() >= 2 && item.front() == 'g') {
-    const auto [end, ec] = std::from_chars(item.data() + 1, item.data() + item.size(), group);
-    if (ec == std::errc{} && end == item.data() + item.size() && group < kGroupCount) {
-      selection.add_group(group);
+    if (const std::optional<unsigned> group = parse_number<unsigned>(item.substr(1));
+        group && *group < kGroupCount) {
+      selection.add_group(*group);
       return true;
     }
   }
@@ -67,9 +66,8 @@ bool Schedule::add(std::string_view spec, std::string& error) {
     return false;
   }
   const std::string_view period_text = trimmed(spec.substr(0, colon));
-  std::uint64_t period = 0;
-  const auto [end, ec] = std::from_chars(period_text.data(), period_text.data() + period_text.size(), period);
-  if (ec != std::errc{} || end != period_text.data() + period_text.size() || period == 0) {
+  const std::uint64_t period = parse_number<std::uint64_t>(period_text).value_or(0);
+  if (period == 0) {
     error = "'" + std::string(period_text) + "' in '" + std::string(spec) + "' is not a period N >= 1";
     return false;
   }
