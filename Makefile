@@ -14,7 +14,8 @@ packages    = $(shell grep -hv '^\s*\#' $(addprefix docker/packages/,$(addsuffix
 DEPS_DIR   ?= $(CURDIR)/.deps
 # ccache (in docker/packages/build.txt) makes the three builds of `make test` and a rebuild after a
 # branch switch cheap; paths are taken relative to the checkout so clones share the cache.
-CCACHE     := -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache
+CCACHE     := -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache \
+              -DRSG_DEPS_DIR=$(DEPS_DIR)
 export CCACHE_BASEDIR := $(CURDIR)
 export CCACHE_NOHASHDIR := true
 SUDO       := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
