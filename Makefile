@@ -12,9 +12,10 @@ ASAN_OPTIONS ?= new_delete_type_mismatch=0
 packages    = $(shell grep -hv '^\s*\#' $(addprefix docker/packages/,$(addsuffix .txt,$(1))))
 # Project-local tools from PyPI and the Go module proxy, pinned with hashes (git-ignored).
 DEPS_DIR   ?= $(CURDIR)/.deps
-# ccache (in docker/packages/build.txt) makes the three builds of `make test` and a rebuild after a
-# branch switch cheap; paths are taken relative to the checkout so clones share the cache.
-CCACHE     := -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache \
+# Every CMake configure: ccache (in docker/packages/build.txt) makes the three builds of `make test` and a rebuild after a
+# branch switch cheap (paths relative to the checkout, so clones share the cache); and where
+# make deps put the project-local tools.
+CMAKE_COMMON :=  -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache \
               -DRSG_DEPS_DIR=$(DEPS_DIR)
 export CCACHE_BASEDIR := $(CURDIR)
 export CCACHE_NOHASHDIR := true
@@ -57,7 +58,7 @@ deps: deps-run
 	@for script in tools/deps/*.sh; do DEPS_DIR=$(DEPS_DIR) $$script || exit 1; done
 
 build: deps
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CCACHE)
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_COMMON)
 	cmake --build $(BUILD) -j $(JOBS)
 
 # Tools, profiles, IDL, client libraries and headers, and the CMake package (find_package(rsg)).
@@ -67,12 +68,12 @@ install: build
 
 # Unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer.
 unit-asan: deps
-	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DRSG_SANITIZE=ON $(CCACHE)
+	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DRSG_SANITIZE=ON $(CMAKE_COMMON)
 	cmake --build $(ASAN_BUILD) -j $(JOBS) --target unit_tests
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) ctest --output-on-failure -L unit 2>&1 | tee ctest.log
 
 fuzz-build: deps
-	CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_BUILD) -DRSG_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CCACHE)
+	CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_BUILD) -DRSG_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_COMMON)
 	cmake --build $(FUZZ_BUILD) -j $(JOBS)
 
 # Each fuzzer for FUZZ_SECONDS (make fuzz FUZZ_SECONDS=600 for a long run).
@@ -90,7 +91,7 @@ test: build
 # Only what the demo runs, with only the build and run packages: a fresh machine shows samples fast.
 DEMO_TARGETS := rsg_gateway rsg_sim rsg_echo rsg_view
 build-demo: deps-run
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CCACHE)
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_COMMON)
 	cmake --build $(BUILD) -j $(JOBS) --target $(DEMO_TARGETS)
 
 demo: build-demo
