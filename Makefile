@@ -12,11 +12,11 @@ ASAN_OPTIONS ?= new_delete_type_mismatch=0
 packages    = $(shell grep -hv '^\s*\#' $(addprefix docker/packages/,$(addsuffix .txt,$(1))))
 # Project-local tools from PyPI and the Go module proxy, pinned with hashes (git-ignored).
 DEPS_DIR   ?= $(CURDIR)/.deps
-# Every CMake configure: ccache (in docker/packages/build.txt) makes the three builds of `make test` and a rebuild after a
-# branch switch cheap (paths relative to the checkout, so clones share the cache); and where
-# make deps put the project-local tools.
-CMAKE_COMMON :=  -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache \
-              -DRSG_DEPS_DIR=$(DEPS_DIR)
+# Every CMake configure gets these: ccache (docker/packages/build.txt) makes the three builds of
+# `make test` and a rebuild after a branch switch cheap (paths relative to the checkout, so clones
+# share the cache); RSG_DEPS_DIR is where make deps put the project-local tools.
+CMAKE_COMMON := -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache \
+                -DRSG_DEPS_DIR=$(DEPS_DIR)
 export CCACHE_BASEDIR := $(CURDIR)
 export CCACHE_NOHASHDIR := true
 SUDO       := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
