@@ -26,6 +26,7 @@ import os
 import re
 import shlex
 import shutil
+import socket
 import subprocess
 import sys
 import tempfile
@@ -47,7 +48,6 @@ IMAGE_UID = 10001  # the image's user (docker/Dockerfile)
 
 
 def free_tcp_port():
-    import socket
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
         probe.bind(("127.0.0.1", 0))
         return probe.getsockname()[1]
