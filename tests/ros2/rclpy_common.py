@@ -1,0 +1,140 @@
+"""What the rclpy tests share: the project's ROS 2 environment (make deps: .deps/ros2 and
+.deps/ros2_ws/install, set up by ros2/env.sh), starting rclpy_peer.py in it, and rsg_sim's canonical
+JSON as the RobotState message a ROS 2 node must see.
+
+The tests themselves run under any Python 3 (ctest's); only rclpy_peer.py runs in the ROS 2
+environment, on the test's DDS domain (ROS_DOMAIN_ID = the gateway's --domain).
+"""
+import json
+import os
+import re
+import subprocess
+from pathlib import Path
+
+from harness import check, wait_for
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parents[1]
+PEER = HERE / "rclpy_peer.py"
+
+
+class RosEnv:
+    """The variables ros2/env.sh sets, read once; fails naming `make deps` when they are missing
+    or when the workspace was built from other .msg files than the repository's."""
+
+    def __init__(self, domain):
+        deps = os.environ.get("RSG_DEPS_DIR") or str(REPO / ".deps")
+        shell = subprocess.run(["bash", "-c", f'. "{REPO}/ros2/env.sh" > /dev/null && env -0'],
+                               env={**os.environ, "RSG_DEPS_DIR": deps}, capture_output=True)
+        check(shell.returncode == 0,
+              f"no ROS 2 environment in {deps} (the ROS 2 Kilted wheels and the rsg_msgs/tf2_msgs workspace): "
+              f"run `make deps` ({shell.stderr.decode().strip()})")
+        variables = dict(item.split("=", 1) for item in shell.stdout.decode().split("\0") if "=" in item)
+        keep = ("PATH", "LD_LIBRARY_PATH", "PYTHONPATH", "AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH", "RMW_IMPLEMENTATION",
+                "ROS_DISTRO", "ROS_VERSION", "ROS_PYTHON_VERSION", "_ROS_WHEELS_BOOTSTRAP_COMPLETE", "RSG_ROS2_VENV",
+                "RSG_ROS2_INSTALL")
+        self.vars = {key: variables[key] for key in keep if key in variables}
+        self.vars["ROS_DOMAIN_ID"] = str(domain)
+        self.vars["ROS_LOG_DIR"] = os.environ.get("TMPDIR", "/tmp")
+        self.python = str(Path(self.vars["RSG_ROS2_VENV"]) / "bin" / "python")
+        self.install = Path(self.vars["RSG_ROS2_INSTALL"])
+        for name in ("RobotState.msg", "GatewayStatus.msg"):
+            built = self.install / "share/rsg_msgs/msg" / name
+            source = REPO / "ros2/rsg_msgs/msg" / name
+            check(built.exists() and built.read_text() == source.read_text(),
+                  f"{built} is not the repository's {name}: run `make deps` to rebuild the ROS 2 workspace")
+
+        self.deps = deps
+        self.domain = domain
+
+    def argv(self, *args):
+        """argv running rclpy_peer.py the way a user would: ros2/env.sh sourced, ROS_DOMAIN_ID set
+        (the harness starts children with the test's own environment)."""
+        return ["env", f"ROS_DOMAIN_ID={self.domain}", f"RSG_DEPS_DIR={self.deps}", f"ROS_LOG_DIR={self.vars['ROS_LOG_DIR']}",
+                "bash", "-c", '. "$0" && exec python "$@"', str(REPO / "ros2/env.sh"), str(PEER), *map(str, args)]
+
+    def type_hash(self, package, name):
+        """The RIHS01 hash rosidl's type-description generator computed for package/msg/name."""
+        description = json.loads((self.install / "share" / package / "msg" / f"{name}.json").read_text())
+        for entry in description["type_hashes"]:
+            if entry["type_name"] == f"{package}/msg/{name}":
+                return entry["hash_string"]
+        raise AssertionError(f"no hash of {package}/msg/{name} in its type description")
+
+    def standard_type_hash(self, package, name):
+        """Same, for a type of the wheels (sensor_msgs, geometry_msgs) or of the workspace (tf2_msgs)."""
+        for prefix in (self.install, Path(self.vars["RSG_ROS2_VENV"])):
+            path = prefix / "share" / package / "msg" / f"{name}.json"
+            if path.exists():
+                for entry in json.loads(path.read_text())["type_hashes"]:
+                    if entry["type_name"] == f"{package}/msg/{name}":
+                        return entry["hash_string"]
+        raise AssertionError(f"no type description of {package}/msg/{name}")
+
+
+def start_peer(h, env, label, *args):
+    return h.start(label, env.argv(*args))
+
+
+def wait_peer_matched(h, label, count=1):
+    """Both sides of discovery: the node's own matched event (rclpy_peer prints it)."""
+    err = h.dir / f"{label}.err"
+    wait_for(lambda: err.exists() and any(line.startswith("matched ") and int(line.split()[1]) >= count
+                                          for line in err.read_text(errors="replace").splitlines()),
+             f"{label}'s ROS 2 subscription or publisher to match")
+
+
+def error_flag_names():
+    """kErrorFlagNames of include/rsg/wire/error_flags.hpp: canonical JSON lists the set bits of
+    current_errors and last_motion_errors by name, the message carries the uint64."""
+    header = (REPO / "include/rsg/wire/error_flags.hpp").read_text()
+    body = header[header.index("kErrorFlagNames"):]
+    return re.findall(r'"([a-z0-9_]+)"', body[:body.index("};")])
+
+
+ERROR_FLAGS = error_flag_names()
+BITMASK_FIELDS = ("current_errors", "last_motion_errors")
+
+
+def group_present(group_select):
+    return [bool(group_select >> group & 1) for group in range(6)]
+
+
+def expected_message(sent, member_order):
+    """The rsg_msgs/RobotState a frame of canonical JSON must arrive as: header members, then every
+    field member in field-table order (bit g*8+b of data_select) with the frame's value when present
+    and zeros when not (the .msg says so). `member_order` is the message's member names in order."""
+    fields = {name.lower(): value for name, value in sent["fields"].items()}
+    for name in BITMASK_FIELDS:
+        if name in fields:
+            fields[name] = sum(1 << ERROR_FLAGS.index(flag) for flag in fields[name])
+    message = {"packet_number": sent["packet_number"], "group_select": sent["group_select"],
+               "data_select": sent["data_select"], "group_present": group_present(sent["group_select"])}
+    header = list(message)
+    check(member_order[:len(header)] == header, f"RobotState starts with {member_order[:len(header)]}")
+    for index, name in enumerate(member_order[len(header):]):
+        present = sent["data_select"][index // 8] >> (index % 8) & 1
+        message[name] = fields.pop(name) if present else None  # None: zeros, shape from the message
+    check(not fields, f"frame fields that are no RobotState member: {sorted(fields)}")
+    return message
+
+
+def same_message(expected, got):
+    """Member by member; absent fields must be all zeros. Returns the first difference or ''."""
+    if list(expected) != list(got):
+        return f"members {list(got)} instead of {list(expected)}"
+    for name, want in expected.items():
+        value = got[name]
+        if want is None:
+            zero = all(item == 0 for item in value) if isinstance(value, list) else value == 0
+            if not zero:
+                return f"{name} = {value} where the frame had no such field (must be 0)"
+        elif value != want:
+            return f"{name} = {value}, sent {want}"
+    return ""
+
+
+def read_messages(h, label):
+    path = h.output(label)
+    text = path.read_text() if path.exists() else ""
+    return [json.loads(line) for line in text.split("\n")[:-1] if line.strip()]

@@ -1,0 +1,52 @@
+"""ROS 2 egress from a real ROS 2 node: an rclpy publisher of rsg_msgs/msg/RobotState (rosidl-built,
+rmw_fastrtps_cpp, default QoS) on /robot1/robot_state_cmd makes rsg_gateway --ros2 --ros2-namespace
+/robot1 --send-to send each message as the raw frame it describes, byte for byte what rsg_frame
+encodes from the same canonical JSON (zeros for fields the frame does not select; -0.0, 1e-300 and
+a uint64 time above 2^63 survive).
+"""
+import json
+import socket
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
+from harness import check, main, wait_for_stats  # noqa: E402
+from rclpy_common import RosEnv, group_present, start_peer  # noqa: E402
+from test_ros2_egress import check_egress, command_records, encode  # noqa: E402
+
+
+def message_of(record, member_order):
+    """The RobotState message for a canonical frame: selected fields by their lowercase names."""
+    message = {"packet_number": record["packet_number"], "group_select": record["group_select"],
+               "data_select": record["data_select"], "group_present": group_present(record["group_select"])}
+    message.update({name.lower(): value for name, value in record["fields"].items()})
+    check(all(name in member_order for name in message), f"not RobotState members: {set(message) - set(member_order)}")
+    return message
+
+
+def body(h):
+    env = RosEnv(h.domain)
+    records = command_records()
+    _, expected = encode(h, records)
+    members = (Path(env.install) / "share/rsg_msgs/msg/RobotState.msg").read_text()
+    order = [line.split()[1] for line in members.splitlines()
+             if line.strip() and not line.startswith("#") and "=" not in line.split("#")[0]]
+    messages = h.dir / "cmd.messages.jsonl"
+    messages.write_text("".join(json.dumps(message_of(r, order)) + "\n" for r in records))
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sink:
+        sink.bind(("127.0.0.1", 0))
+        sink.settimeout(30)
+        gateway, stats = h.gateway("gateway", "--ros2", "--ros2-namespace", "/robot1",
+                                   "--send-to", f"127.0.0.1:{sink.getsockname()[1]}")
+        wait_for_stats(stats, lambda s: True, "the gateway to start")
+        publisher = start_peer(h, env, "publisher", "pub", "/robot1/robot_state_cmd", "rsg_msgs/msg/RobotState",
+                               "--file", messages, "--timeout", 60)
+        # The node publishes once its publisher matched the gateway's reader and exits 0 only when
+        # that reader acknowledged every message (so it had matched the node too).
+        check(h.wait("publisher", publisher, 90) == 0, "the rclpy publisher's messages were not all acknowledged")
+        check_egress(h, sink, expected, stats, gateway)
+
+
+if __name__ == "__main__":
+    sys.exit(main("rclpy_egress", body))
