@@ -8,45 +8,11 @@
 #include <memory>
 #include <stdexcept>
 
-#include "rsg/wire/number.hpp"
-
 namespace rsg {
 namespace {
 
 using eprosima::fastrtps::rtps::IPLocator;
 using eprosima::fastrtps::rtps::Locator_t;
-
-struct HostPort {
-  std::string host;
-  unsigned port = 0;  // 0: none given
-};
-
-// "HOST:PORT", or "HOST" when the port is optional. Returns what is wrong, or "".
-std::string split_host_port(const std::string& value, bool port_required, HostPort& out) {
-  const std::size_t colon = value.rfind(':');
-  if (colon == std::string::npos) {
-    if (port_required || value.empty()) return "'" + value + "' is not HOST:PORT";
-    out.host = value;
-    return {};
-  }
-  out.host = value.substr(0, colon);
-  if (out.host.empty()) return "'" + value + "' has no HOST";
-  out.port = parse_number<unsigned>(std::string_view(value).substr(colon + 1)).value_or(0);
-  if (out.port == 0 || out.port > 65535) return "'" + value + "': port must be a number 1..65535";
-  return {};
-}
-
-// "[ID@]HOST:PORT"; `id` is left alone when the value names none.
-std::string split_server(const std::string& value, unsigned& id, HostPort& out) {
-  std::string host_port = value;
-  if (const std::size_t at = value.find('@'); at != std::string::npos) {
-    const std::optional<unsigned> given = parse_number<unsigned>(std::string_view(value).substr(0, at));
-    if (!given || *given > 255) return "'" + value + "': server id before '@' must be 0..255";
-    id = *given;
-    host_port = value.substr(at + 1);
-  }
-  return split_host_port(host_port, /*port_required=*/true, out);
-}
 
 std::string resolve_ipv4(const std::string& host, const std::string& value) {
   addrinfo hints{};
@@ -70,17 +36,6 @@ Locator_t udp_locator(const std::string& address, std::uint32_t port) {
 
 }  // namespace
 
-std::string check_discovery_server(const std::string& value) {
-  unsigned id = 0;
-  HostPort parsed;
-  return split_server(value, id, parsed);
-}
-
-std::string check_peer(const std::string& value) {
-  HostPort parsed;
-  return split_host_port(value, /*port_required=*/false, parsed);
-}
-
 void apply_discovery(const DiscoveryOptions& options, int domain,
                      eprosima::fastdds::dds::DomainParticipantQos& qos) {
   auto& builtin = qos.wire_protocol().builtin;
@@ -88,7 +43,8 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
     const std::string& value = options.servers[index];
     auto id = static_cast<unsigned>(index);
     HostPort server;
-    if (auto error = split_server(value, id, server); !error.empty()) throw std::invalid_argument(error);
+    if (auto error = split_discovery_server(value, id, server); !error.empty())
+      throw std::invalid_argument(error);
     eprosima::fastdds::rtps::RemoteServerAttributes remote;
     eprosima::fastdds::rtps::get_server_client_default_guidPrefix(static_cast<int>(id), remote.guidPrefix);
     remote.metatrafficUnicastLocatorList.push_back(
@@ -115,7 +71,7 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
   const auto& ports = qos.wire_protocol().port;
   for (const std::string& value : options.peers) {
     HostPort peer;
-    if (auto error = split_host_port(value, /*port_required=*/false, peer); !error.empty())
+    if (auto error = split_host_port(value, HostPortRule::kPortOptional, peer); !error.empty())
       throw std::invalid_argument(error);
     const std::string address = resolve_ipv4(peer.host, value);
     if (peer.port != 0) {

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "rsg/dds/ros2.hpp"
+#include "rsg/transport/host_port.hpp"
 #include "rsg/wire/number.hpp"
 #include "source_filter.hpp"
 
@@ -20,39 +21,17 @@ std::string join(const std::vector<std::string>& items) {
   return joined;
 }
 
-// Syntax only: "HOST:PORT" or "[V6]:PORT". Names are resolved when the gateway starts, not here,
-// so parsing a configuration never touches the network.
-std::string check_host_port(const std::string& value, bool allow_port_zero) {
-  const std::size_t colon = value.rfind(':');
-  if (colon == std::string::npos || colon == 0) return "'" + value + "' is not HOST:PORT";
-  const std::string_view port = std::string_view(value).substr(colon + 1);
-  const std::optional<unsigned> number = parse_number<unsigned>(port);
-  if (!number || *number > 65535 || (*number == 0 && !allow_port_zero))
-    return "'" + value + "': port must be a number " + (allow_port_zero ? "0" : "1") + "..65535";
-  return {};
+// Syntax only (rsg/transport/host_port.hpp): names are resolved when the gateway starts.
+std::string check_host_port(const std::string& value, HostPortRule rule) {
+  HostPort parsed;
+  return split_host_port(value, rule, parsed);
 }
 
 std::string check_optional_host_port(const std::string& value) {
-  return value.empty() ? std::string() : check_host_port(value, false);
+  return value.empty() ? std::string() : check_host_port(value, HostPortRule::kPortRequired);
 }
 
 std::string check_not_empty(const std::string& value) { return value.empty() ? "must not be empty" : ""; }
-
-// "[ID@]HOST:PORT" (rsg/dds/discovery.hpp; kept here in syntax only so that the configuration
-// needs no DDS to be checked, nor to be fuzzed).
-std::string check_discovery_server(const std::string& value) {
-  const std::size_t at = value.find('@');
-  if (at == std::string::npos) return check_host_port(value, false);
-  const std::optional<unsigned> id = parse_number<unsigned>(std::string_view(value).substr(0, at));
-  if (!id || *id > 255) return "'" + value + "': server id before '@' must be 0..255";
-  return check_host_port(value.substr(at + 1), false);
-}
-
-// "HOST" or "HOST:PORT".
-std::string check_peer(const std::string& value) {
-  if (value.empty()) return "a peer must not be empty";
-  return value.find(':') == std::string::npos ? std::string() : check_host_port(value, false);
-}
 
 std::string check_each(const std::vector<std::string>& values, std::string (*check)(const std::string&)) {
   for (const auto& value : values)
@@ -74,7 +53,9 @@ std::string check_frame(const std::string& value) {
 
 const std::array kKeys = {
     ConfigKey{"listen", "Receive raw frames on HOST:PORT (UDP) and publish them", &GatewayConfig::listen,
-              [](const GatewayConfig& c) { return c.listen.empty() ? "" : check_host_port(c.listen, true); }},
+              [](const GatewayConfig& c) {
+                return c.listen.empty() ? "" : check_host_port(c.listen, HostPortRule::kPortMayBeZero);
+              }},
     ConfigKey{"allow-from", "Accept frames only from ADDR[/PREFIX] (repeatable; IPv4 or IPv6)",
               &GatewayConfig::allow_from,
               [](const GatewayConfig& c) {
@@ -111,7 +92,8 @@ const std::array kKeys = {
     ConfigKey{"send-to", "Destination HOST:PORT of egress frames (repeatable)", &GatewayConfig::send_to,
               [](const GatewayConfig& c) {
                 for (const auto& destination : c.send_to)
-                  if (auto error = check_host_port(destination, false); !error.empty()) return error;
+                  if (auto error = check_host_port(destination, HostPortRule::kPortRequired); !error.empty())
+                    return error;
                 return std::string();
               }},
     ConfigKey{
@@ -239,16 +221,10 @@ const std::array kKeys = {
               [](const GatewayConfig& c) { return check_not_empty(c.reader_profile); }},
     ConfigKey{"status-profile", "XML data writer profile of the status topic", &GatewayConfig::status_profile,
               [](const GatewayConfig& c) { return check_not_empty(c.status_profile); }},
-    ConfigKey{
-        "discovery-server",
-        "Find the other participants through this Fast DDS Discovery Server, [ID@]HOST:PORT (repeatable; "
-        "ID defaults to the position in the list, as `fastdds discovery -i ID`)",
-        &GatewayConfig::discovery_servers,
-        [](const GatewayConfig& c) { return check_each(c.discovery_servers, check_discovery_server); }},
-    ConfigKey{"peer",
-              "Send discovery announcements to this unicast peer instead of multicast, HOST[:PORT] "
-              "(repeatable; HOST alone covers participant ids 0..59)",
-              &GatewayConfig::peers, [](const GatewayConfig& c) { return check_each(c.peers, check_peer); }},
+    ConfigKey{"discovery-server", kDiscoveryServerHelp, &GatewayConfig::discovery_servers,
+              [](const GatewayConfig& c) { return check_each(c.discovery_servers, check_discovery_server); }},
+    ConfigKey{"peer", kPeerHelp, &GatewayConfig::peers,
+              [](const GatewayConfig& c) { return check_each(c.peers, check_peer); }},
 };
 
 const ConfigKey* find_key(std::string_view name) {

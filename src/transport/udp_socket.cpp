@@ -11,15 +11,17 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "rsg/transport/host_port.hpp"
+
 namespace rsg {
 
 Endpoint Endpoint::parse(std::string_view host_port) {
   const std::string text(host_port);
-  const std::size_t colon = text.rfind(':');
-  if (colon == std::string::npos || colon + 1 == text.size())
-    throw std::invalid_argument("'" + text + "' is not HOST:PORT");
-  std::string host = text.substr(0, colon);
-  const std::string port = text.substr(colon + 1);
+  HostPort parts;
+  if (std::string error = split_host_port(text, HostPortRule::kBindAddress, parts); !error.empty())
+    throw std::invalid_argument(error);
+  std::string host = std::move(parts.host);
+  const std::string port = std::to_string(parts.port);
   if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
   if (host.empty() || host == "*") host = "0.0.0.0";
 

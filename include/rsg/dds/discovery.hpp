@@ -13,16 +13,13 @@
 // get_server_client_default_guidPrefix), so nothing else has to be copied between machines.
 #pragma once
 
-#include <cstdint>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <string>
 #include <vector>
 
-namespace rsg {
+#include "rsg/transport/host_port.hpp"  // check_discovery_server, check_peer, kGatewayParticipantIds
 
-/// How many participant ids the gateway picks from (its pid modulo this), and so how many ports
-/// a bare-HOST peer is tried on: 60 keeps every domain's ports below 65536.
-inline constexpr std::uint32_t kGatewayParticipantIds = 60;
+namespace rsg {
 
 struct DiscoveryOptions {
   /// Discovery Servers, "[ID@]HOST:PORT": the participant becomes their CLIENT and sends no
@@ -36,12 +33,6 @@ struct DiscoveryOptions {
 
   bool empty() const { return servers.empty() && peers.empty(); }
 };
-
-/// What is wrong with one `--discovery-server` value ("" when it is well-formed). Syntax only:
-/// names are resolved by apply_discovery, so checking a configuration touches no network.
-std::string check_discovery_server(const std::string& value);
-/// Same for one `--peer` value.
-std::string check_peer(const std::string& value);
 
 /// Makes `qos` use the given servers or peers on `domain` (nothing changes when `options` is
 /// empty). With either, the participant announces itself at Fast DDS's default period (3 s), not

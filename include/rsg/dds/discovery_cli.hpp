@@ -17,14 +17,9 @@ inline void add_discovery_options(CLI::App& app, DiscoveryOptions& options) {
   const auto each = [](std::string (*check)(const std::string&)) {
     return CLI::Validator([check](std::string& value) { return check(value); }, "", "");
   };
-  app.add_option("--discovery-server", options.servers,
-                 "Find the other participants through this Fast DDS Discovery Server, [ID@]HOST:PORT "
-                 "(repeatable; ID defaults to the position in the list, as `fastdds discovery -i ID`)")
+  app.add_option("--discovery-server", options.servers, std::string(kDiscoveryServerHelp))
       ->check(each(check_discovery_server));
-  app.add_option("--peer", options.peers,
-                 "Send discovery announcements to this unicast peer instead of multicast, HOST[:PORT] "
-                 "(repeatable; HOST alone covers participant ids 0..59)")
-      ->check(each(check_peer));
+  app.add_option("--peer", options.peers, std::string(kPeerHelp))->check(each(check_peer));
 }
 
 }  // namespace rsg
