@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "rsg/dds/robot_state.hpp"
+#include "ros2_type_hash.hpp"
 
 namespace rsg::gateway {
 namespace {
@@ -22,7 +23,7 @@ Egress::Egress(Participant& participant, const Options& options) : participant_(
 
   subscriber_ = participant_.subscriber(options.partitions);
   fdds::Topic* topic = participant_.robot_state_topic(options.topic, options.type_name);
-  reader_ = subscriber_->create_datareader_with_profile(topic, options.reader_profile);
+  reader_ = create_reader_with_profile(*subscriber_, topic, options.reader_profile);
   if (!reader_) {
     participant_.get()->delete_subscriber(subscriber_);
     throw std::runtime_error("cannot create the RobotState reader with profile '" + options.reader_profile +

@@ -5,6 +5,8 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <stdexcept>
 
+#include "ros2_type_hash.hpp"
+
 namespace rsg::gateway {
 namespace {
 
@@ -78,7 +80,7 @@ Ingress::Ingress(Participant& participant, Options options)
 
   publisher_ = participant_.publisher(options_.partitions);
   fdds::Topic* topic = participant_.robot_state_topic(options_.topic, options_.type_name);
-  writer_ = publisher_->create_datawriter_with_profile(topic, options_.writer_profile);
+  writer_ = create_writer_with_profile(*publisher_, topic, options_.writer_profile);
   if (!writer_) {
     participant_.get()->delete_publisher(publisher_);
     throw std::runtime_error("cannot create the RobotState writer with profile '" + options_.writer_profile +
@@ -87,7 +89,7 @@ Ingress::Ingress(Participant& participant, Options options)
   for (const auto& rate : options_.rate_topics) {
     fdds::Topic* rate_topic = participant_.robot_state_topic(rate.topic, options_.type_name);
     fdds::DataWriter* rate_writer =
-        publisher_->create_datawriter_with_profile(rate_topic, options_.writer_profile);
+        create_writer_with_profile(*publisher_, rate_topic, options_.writer_profile);
     if (!rate_writer) {
       publisher_->delete_contained_entities();
       participant_.get()->delete_publisher(publisher_);

@@ -8,6 +8,7 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <stdexcept>
 
+#include "ros2_type_hash.hpp"
 #include "rsg/dds/eigen.hpp"
 
 namespace rsg::gateway {
@@ -103,7 +104,9 @@ Ros2StandardTopics::~Ros2StandardTopics() {
 void Ros2StandardTopics::create(Writer& writer, const std::optional<Output>& output, fdds::TypeSupport type) {
   if (!output) return;
   fdds::Topic* topic = participant_.topic(output->topic, type);
-  writer.writer = publisher_.create_datawriter(topic, writer_qos(publisher_));
+  fdds::DataWriterQos qos = writer_qos(publisher_);
+  announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
+  writer.writer = publisher_.create_datawriter(topic, qos);
   if (!writer.writer) throw std::runtime_error("cannot create the writer of '" + output->topic + "'");
   writer.decimator.emplace(output->decimation);
 }

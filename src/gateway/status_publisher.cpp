@@ -6,6 +6,7 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <stdexcept>
 
+#include "ros2_type_hash.hpp"
 #include "status_sample.hpp"
 
 namespace rsg::gateway {
@@ -19,7 +20,7 @@ StatusPublisher::StatusPublisher(Participant& participant, const std::string& to
   fdds::TypeSupport type(new GatewayStatusPubSubType());
   if (!type_name.empty()) type->setName(type_name.c_str());
   fdds::Topic* status_topic = participant_.topic(topic, type);
-  writer_ = publisher_->create_datawriter_with_profile(status_topic, profile);
+  writer_ = create_writer_with_profile(*publisher_, status_topic, profile);
   if (!writer_) {
     participant_.get()->delete_publisher(publisher_);
     throw std::runtime_error("cannot create the GatewayStatus writer with profile '" + profile + "'");

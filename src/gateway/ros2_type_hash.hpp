@@ -1,0 +1,65 @@
+// The RIHS01 type hash a ROS 2 node expects in the USER_DATA of rsg's writers and readers of ROS 2
+// types: "typehash=RIHS01_<64 hex>;", as rmw_fastrtps (rmw_dds_common) writes it and reads it for
+// `ros2 topic info -v` and type checks. The hashes come from rosidl at build time
+// (cmake/rsg_ros2_type_hashes.cmake); without the ROS 2 environment the list is empty and nothing is
+// announced.
+#pragma once
+
+#include <fastdds/dds/core/policy/QosPolicies.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <string>
+#include <string_view>
+
+#include "rsg_ros2_type_hashes.hpp"
+
+namespace rsg::gateway {
+
+/// The hash rosidl computed for a ROS 2 type, by its DDS name ("rsg_msgs::msg::dds_::RobotState_") or
+/// its ROS name ("rsg_msgs/msg/RobotState"); "" when unknown (not a ROS 2 type, or no hashes built).
+inline std::string_view ros2_type_hash(std::string_view type_name) {
+  std::string ros_name(type_name);
+  if (const auto dds = ros_name.find("::msg::dds_::"); dds != std::string::npos && ros_name.ends_with('_'))
+    ros_name = ros_name.substr(0, dds) + "/msg/" + ros_name.substr(dds + 13, ros_name.size() - dds - 14);
+  for (const auto& [name, hash] : ros2_generated::kTypeHashes)
+    if (name == ros_name) return hash;
+  return {};
+}
+
+/// Puts "typehash=<hash>;" of `type_name` into `user_data` (replacing what was there) when the hash
+/// is known; leaves it alone otherwise.
+inline void announce_ros2_type_hash(eprosima::fastdds::dds::UserDataQosPolicy& user_data, std::string_view type_name) {
+  const std::string_view hash = ros2_type_hash(type_name);
+  if (hash.empty()) return;
+  const std::string text = "typehash=" + std::string(hash) + ";";
+  user_data.setValue(std::vector<eprosima::fastrtps::rtps::octet>(text.begin(), text.end()));
+}
+
+/// create_datawriter_with_profile, with the topic type's hash announced when it has one.
+inline eprosima::fastdds::dds::DataWriter* create_writer_with_profile(eprosima::fastdds::dds::Publisher& publisher,
+                                                                      eprosima::fastdds::dds::Topic* topic,
+                                                                      const std::string& profile) {
+  eprosima::fastdds::dds::DataWriterQos qos;
+  if (ros2_type_hash(topic->get_type_name()).empty() ||
+      publisher.get_datawriter_qos_from_profile(profile, qos) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+    return publisher.create_datawriter_with_profile(topic, profile);
+  announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
+  return publisher.create_datawriter(topic, qos);
+}
+
+/// create_datareader_with_profile, with the topic type's hash announced when it has one.
+inline eprosima::fastdds::dds::DataReader* create_reader_with_profile(eprosima::fastdds::dds::Subscriber& subscriber,
+                                                                      eprosima::fastdds::dds::Topic* topic,
+                                                                      const std::string& profile) {
+  eprosima::fastdds::dds::DataReaderQos qos;
+  if (ros2_type_hash(topic->get_type_name()).empty() ||
+      subscriber.get_datareader_qos_from_profile(profile, qos) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+    return subscriber.create_datareader_with_profile(topic, profile);
+  announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
+  return subscriber.create_datareader(topic, qos);
+}
+
+}  // namespace rsg::gateway
