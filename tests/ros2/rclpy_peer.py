@@ -9,8 +9,9 @@ project's ROS 2 environment (ros2/env.sh), never imported by the tests themselve
   pub TOPIC TYPE --file JSONL [--wait-subscribers N] [--period S]
       publishes one message per line of the file (members by name, like sub prints them) once it
       matched N subscriptions, then waits until they acknowledged everything
-  graph TOPIC... [--wait-publishers N] [--timeout S]
-      prints, per topic, what `ros2 topic info -v` shows: get_publishers_info_by_topic as JSON
+  graph TOPIC... [--wait-publishers N] [--subscriptions] [--timeout S]
+      prints, per topic, what `ros2 topic info -v` shows: get_publishers_info_by_topic (or with
+      --subscriptions get_subscriptions_info_by_topic) as JSON
   churn --count N --topic TOPIC [--hold S]
       N times: rclpy.init (a new DDS participant), a node with a default-QoS RobotState
       subscription, wait for its match and one message (at most --hold s), shut down
@@ -160,6 +161,8 @@ def graph(args):
     result = {}
 
     def infos(topic):
+        if args.subscriptions:
+            return node.get_subscriptions_info_by_topic(topic)
         return node.get_publishers_info_by_topic(topic)
 
     spin_until(node, lambda: all(len(infos(topic)) >= args.wait_publishers for topic in args.topics), args.timeout)
@@ -174,7 +177,8 @@ def graph(args):
                 "history": qos.history.name, "depth": qos.depth, "deadline_ns": qos.deadline.nanoseconds,
                 "liveliness": qos.liveliness.name})
     names = node.get_topic_names_and_types()
-    print(json.dumps({"publishers": result, "topics": {name: types for name, types in names}}))
+    kind = "subscriptions" if args.subscriptions else "publishers"
+    print(json.dumps({kind: result, "topics": {name: types for name, types in names}}))
     return 0
 
 
@@ -227,7 +231,8 @@ def main():
     pub.add_argument("--timeout", type=float, default=60)
     info = commands.add_parser("graph")
     info.add_argument("topics", nargs="+")
-    info.add_argument("--wait-publishers", type=int, default=1)
+    info.add_argument("--wait-publishers", type=int, default=1, help="(or subscriptions)")
+    info.add_argument("--subscriptions", action="store_true")
     info.add_argument("--timeout", type=float, default=30)
     ch = commands.add_parser("churn")
     ch.add_argument("--count", type=int, default=50)

@@ -2,7 +2,8 @@
 rmw_fastrtps_cpp, default QoS) on /robot1/robot_state_cmd makes rsg_gateway --ros2 --ros2-namespace
 /robot1 --send-to send each message as the raw frame it describes, byte for byte what rsg_frame
 encodes from the same canonical JSON (zeros for fields the frame does not select; -0.0, 1e-300 and
-a uint64 time above 2^63 survive).
+a uint64 time above 2^63 survive). The graph API shows the gateway's egress reader as a
+subscription of rsg_msgs/msg/RobotState, reliable and volatile, with rosidl's type hash.
 """
 import json
 import socket
@@ -45,7 +46,17 @@ def body(h):
         # The node publishes once its publisher matched the gateway's reader and exits 0 only when
         # that reader acknowledged every message (so it had matched the node too).
         check(h.wait("publisher", publisher, 90) == 0, "the rclpy publisher's messages were not all acknowledged")
+        graph = start_peer(h, env, "graph", "graph", "/robot1/robot_state_cmd", "--subscriptions", "--timeout", 30)
+        check(h.wait("graph", graph, 60) == 0, "the graph query failed")
         check_egress(h, sink, expected, stats, gateway)
+    readers = json.loads(h.output("graph").read_text())["subscriptions"]["/robot1/robot_state_cmd"]
+    check(len(readers) == 1, f"{len(readers)} subscriptions of /robot1/robot_state_cmd in the ROS graph")
+    reader = readers[0]
+    want = env.type_hash("rsg_msgs", "RobotState")
+    check(reader["topic_type"] == "rsg_msgs/msg/RobotState" and reader["topic_type_hash"] == want,
+          f"the egress reader shows as {reader['topic_type']} {reader['topic_type_hash']}, rosidl computed {want}")
+    check(reader["reliability"] == "RELIABLE" and reader["durability"] == "VOLATILE",
+          f"the egress reader asks {reader['reliability']} {reader['durability']}; docs/ros2.md says reliable, volatile")
 
 
 if __name__ == "__main__":
