@@ -20,26 +20,36 @@ stamp=$( { cat "$0" tools/deps/python/ros2.txt; find "${packages[@]}" -type f | 
 [[ -f $ws/.rsg-stamp && $(<"$ws/.rsg-stamp") == "$stamp" ]] && exit 0
 
 echo "make deps: ROS 2 workspace $ws/install (${packages[*]##*/})"
-rm -rf "$ws"
-mkdir -p "$ws"
+# Built beside the one in use and swapped in at the end, so that tests running meanwhile (another
+# engineer's make test) keep a whole workspace. Installed with DESTDIR: the prefix stays $ws/install,
+# which ament bakes into a few files.
+build=$ws/build.new
+stage=$ws/stage
+rm -rf "$build" "$stage" "$ws/build"
+mkdir -p "$build"
 site=$("$venv/bin/python" -c 'import sysconfig; print(sysconfig.get_path("purelib"))')
 libs=$venv/lib
 for dir in "$site"/ros_*.libs; do libs=$libs:$dir; done
-export AMENT_PREFIX_PATH=$ws/install:$venv CMAKE_PREFIX_PATH=$ws/install:$venv
-export PATH=$venv/bin:$PATH LD_LIBRARY_PATH=$ws/install/lib:$libs${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+# The ament index keeps AMENT_PREFIX_PATH as the packages' parent prefixes: the final one, not the stage.
+export AMENT_PREFIX_PATH=$ws/install:$venv CMAKE_PREFIX_PATH=$stage$ws/install:$venv
+export PATH=$venv/bin:$PATH LD_LIBRARY_PATH=$stage$ws/install/lib:$libs${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 export _ROS_WHEELS_BOOTSTRAP_COMPLETE=1
 generator=()
 command -v ninja > /dev/null && generator=(-G Ninja)
 for package in "${packages[@]}"; do
   name=${package##*/}
-  log=$ws/build/$name.log
-  mkdir -p "$ws/build"
-  if ! { cmake -S "$package" -B "$ws/build/$name" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
+  log=$build/$name.log
+  if ! { cmake -S "$package" -B "$build/$name" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
            -DCMAKE_INSTALL_PREFIX="$ws/install" -DBUILD_TESTING=OFF -DPython3_EXECUTABLE="$venv/bin/python3" \
-         && cmake --build "$ws/build/$name" -j2 && cmake --install "$ws/build/$name"; } > "$log" 2>&1; then
+         && cmake --build "$build/$name" -j2 && DESTDIR=$stage cmake --install "$build/$name"; } > "$log" 2>&1; then
     tail -n 40 "$log" >&2
     echo "make deps: building $package with ament_cmake/rosidl failed (whole log: $log)" >&2
     exit 1
   fi
 done
+rm -f "$ws/.rsg-stamp"
+[[ -d $ws/install ]] && mv "$ws/install" "$ws/install.old"
+mv "$stage$ws/install" "$ws/install"
+mv "$build" "$ws/build"
+rm -rf "$ws/install.old" "$stage"
 echo "$stamp" > "$ws/.rsg-stamp"
