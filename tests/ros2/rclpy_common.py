@@ -50,7 +50,8 @@ class RosEnv:
     def argv(self, *args):
         """argv running rclpy_peer.py the way a user would: ros2/env.sh sourced, ROS_DOMAIN_ID set
         (the harness starts children with the test's own environment)."""
-        return ["env", f"ROS_DOMAIN_ID={self.domain}", f"RSG_DEPS_DIR={self.deps}", f"ROS_LOG_DIR={self.vars['ROS_LOG_DIR']}",
+        return ["env", f"ROS_DOMAIN_ID={self.domain}", f"RSG_DEPS_DIR={self.deps}",
+                f"ROS_LOG_DIR={self.vars['ROS_LOG_DIR']}",
                 "bash", "-c", '. "$0" && exec python "$@"', str(REPO / "ros2/env.sh"), str(PEER), *map(str, args)]
 
     def type_hash(self, package, name):
@@ -70,6 +71,14 @@ class RosEnv:
                     if entry["type_name"] == f"{package}/msg/{name}":
                         return entry["hash_string"]
         raise AssertionError(f"no type description of {package}/msg/{name}")
+
+
+def hash_hint(announced):
+    """Why a gateway announces no type hash, for the failure message."""
+    if announced != "INVALID":
+        return ""
+    return (" (none announced: this rsg_gateway was configured without make deps' ROS 2 environment, as "
+            "cmake/rsg_ros2_type_hashes.cmake then says; re-run cmake)")
 
 
 def start_peer(h, env, label, *args):

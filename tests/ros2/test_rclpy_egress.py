@@ -12,7 +12,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, main, wait_for_stats  # noqa: E402
-from rclpy_common import RosEnv, group_present, start_peer  # noqa: E402
+from rclpy_common import RosEnv, group_present, hash_hint, start_peer  # noqa: E402
 from test_ros2_egress import check_egress, command_records, encode  # noqa: E402
 
 
@@ -54,7 +54,8 @@ def body(h):
     reader = readers[0]
     want = env.type_hash("rsg_msgs", "RobotState")
     check(reader["topic_type"] == "rsg_msgs/msg/RobotState" and reader["topic_type_hash"] == want,
-          f"the egress reader shows as {reader['topic_type']} {reader['topic_type_hash']}, rosidl computed {want}")
+          f"the egress reader shows as {reader['topic_type']} {reader['topic_type_hash']}, rosidl computed {want}"
+          + hash_hint(reader["topic_type_hash"]))
     check(reader["reliability"] == "RELIABLE" and reader["durability"] == "VOLATILE",
           f"the egress reader asks {reader['reliability']} {reader['durability']}; docs/ros2.md says reliable, volatile")
 

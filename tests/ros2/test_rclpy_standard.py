@@ -18,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, free_udp_port, main, read_json_lines, wait_for_stats  # noqa: E402
-from rclpy_common import RosEnv, read_messages, start_peer, wait_peer_matched  # noqa: E402
+from rclpy_common import RosEnv, hash_hint, read_messages, start_peer, wait_peer_matched  # noqa: E402
 from test_ros2_standard import check_rotation, check_stamps, in_order, roughly  # noqa: E402
 
 FRAMES = 500
@@ -113,7 +113,7 @@ def body(h):
         package, _, name = type_name.split("/")
         want = env.standard_type_hash(package, name)
         check(writer["topic_type_hash"] == want, f"{topic} announces type hash {writer['topic_type_hash']}, "
-                                                 f"rosidl computed {want}")
+                                                 f"rosidl computed {want}" + hash_hint(writer["topic_type_hash"]))
 
 
 if __name__ == "__main__":

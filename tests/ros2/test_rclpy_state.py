@@ -20,8 +20,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, free_udp_port, main, read_json_lines, wait_for_stats  # noqa: E402
-from rclpy_common import (RosEnv, expected_message, read_messages, same_message, start_peer,  # noqa: E402
-                          wait_peer_matched)
+from rclpy_common import (RosEnv, expected_message, hash_hint, read_messages, same_message,  # noqa: E402
+                          start_peer, wait_peer_matched)
 
 COUNT = 200
 RATE = "200"
@@ -129,7 +129,8 @@ def check_graph(env, info, ns):
             check(writer["deadline_ns"] == deadline, f"{topic} offers a deadline of {writer['deadline_ns']} ns")
         want = env.type_hash("rsg_msgs", type_name)
         check(writer["topic_type_hash"] == want,
-              f"{topic} announces type hash {writer['topic_type_hash']}, rosidl computed {want}")
+              f"{topic} announces type hash {writer['topic_type_hash']}, rosidl computed {want}"
+              + hash_hint(writer["topic_type_hash"]))
         check(info["topics"].get(topic) == [f"rsg_msgs/msg/{type_name}"], f"{topic} in get_topic_names_and_types: "
                                                                           f"{info['topics'].get(topic)}")
 
