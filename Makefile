@@ -53,8 +53,8 @@ deps: deps-run
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends nodejs npm; }
 	@[ tests/record/package-lock.json -ot tests/record/node_modules/.package-lock.json ] || \
 	  npm ci --prefix tests/record --no-audit --no-fund
-	@[ tests/view/package-lock.json -ot tests/view/node_modules/.package-lock.json ] || \
-	  npm ci --prefix tests/view --no-audit --no-fund
+	@[ tests/rsg_view/package-lock.json -ot tests/rsg_view/node_modules/.package-lock.json ] || \
+	  npm ci --prefix tests/rsg_view --no-audit --no-fund
 	@for script in tools/deps/*.sh; do DEPS_DIR=$(DEPS_DIR) $$script || exit 1; done
 
 build: deps

@@ -6,7 +6,7 @@ over loopback and the host's /dev/shm (what docker/compose.yaml sets).
                 to the values sent; the image's HEALTHCHECK passes on the running gateway
   view_and_restart
                 rsg_view serves its page to Debian's headless Chromium on the host
-                (tests/view/check_page.mjs): live samples rsg_sim sent, plotted by Chart.js; then
+                (tests/rsg_view/check_page.mjs): live samples rsg_sim sent, plotted by Chart.js; then
                 the gateway container killed (`ENGINE kill`) and run again, as `restart: on-failure`
                 would, then its process killed from the host (a crash, the Fast DDS 2.9.1 abort's
                 effect) and restarted by the engine itself: the running echo and recorder resume,
@@ -271,7 +271,7 @@ def view_and_restart(c):
                                 f"--user-data-dir={c.dir / 'chromium'}", f"--remote-debugging-port={devtools}",
                                 "about:blank"], stdout=subprocess.DEVNULL, stderr=open(c.dir / "chromium.err", "wb"))
     try:
-        shown = node("tests/view/check_page.mjs", devtools, f"http://127.0.0.1:{ws_port}/", c.dir / "rsg_view.png")
+        shown = node("tests/rsg_view/check_page.mjs", devtools, f"http://127.0.0.1:{ws_port}/", c.dir / "rsg_view.png")
     finally:
         browser.kill()
         browser.wait()

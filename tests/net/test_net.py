@@ -167,7 +167,7 @@ def views(run, h):
     read_ops2 = run.bed.counters("ops2", {"samples": ("input", big)})
     gateway, stats = run.gateway()
     # Best effort, so that no repair can add a datagram: what crosses is exactly what the writer
-    # sends, once (a reliable view reader is filtered the same way; tests/views covers it).
+    # sends, once (a reliable view reader is filtered the same way; tests/dds_views covers it).
     _, joints = run.reader("ops1", "echo_joints", "--view", "view_joints", qos="reader_realtime")
     _, everything = run.reader("ops2", "echo_all")
     wait_matched(h, stats, ["echo_joints", "echo_all"], "rsg_echo")

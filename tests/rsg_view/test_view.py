@@ -35,11 +35,11 @@ def free_tcp_port():
 
 
 def node():
-    """Node and the packages of tests/view; fails the test (never skips) when they are missing."""
+    """Node and the packages of tests/rsg_view; fails the test (never skips) when they are missing."""
     path = shutil.which("node")
     check(path is not None, "node is not installed: run `make deps`")
     check((HERE / "node_modules" / "@foxglove" / "ws-protocol").is_dir(),
-          "tests/view/node_modules is missing: run `make deps` (npm ci --prefix tests/view)")
+          "tests/rsg_view/node_modules is missing: run `make deps` (npm ci --prefix tests/rsg_view)")
     return path
 
 
