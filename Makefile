@@ -88,14 +88,17 @@ test: build
 	$(MAKE) fuzz FUZZ_SECONDS=20
 	@tests/summarize.sh $(BUILD)/ctest.log $(ASAN_BUILD)/ctest.log -- $(FUZZ_BUILD)/fuzz.log
 
-# Only what the demo runs, with only the build and run packages: a fresh machine shows samples fast.
+# Only what the demo runs, with only the build and run packages, optimised without debug info and
+# without configuring the tests (a third less compiling than in $(BUILD)): a fresh machine shows
+# samples fast. Its own tree, so that neither build's flags rebuild the other's.
+DEMO_BUILD   ?= build-demo
 DEMO_TARGETS := rsg_gateway rsg_sim rsg_echo rsg_view
 build-demo: deps-run
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_COMMON)
-	cmake --build $(BUILD) -j $(JOBS) --target $(DEMO_TARGETS)
+	cmake -S . -B $(DEMO_BUILD) -DCMAKE_BUILD_TYPE=Release -DRSG_BUILD_TESTS=OFF $(CMAKE_COMMON)
+	cmake --build $(DEMO_BUILD) -j $(JOBS) --target $(DEMO_TARGETS)
 
 demo: build-demo
-	src/tools/demo.sh $(BUILD)/bin
+	src/tools/demo.sh $(DEMO_BUILD)/bin
 
 bench: build
 	tests/bench/run_bench.sh $(BUILD)
@@ -111,7 +114,7 @@ format:
 	git ls-files '*.cpp' '*.hpp' '*.h' '*.c' | xargs clang-format -i
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) $(DEMO_BUILD)
 
 # The container image (docs/container.md) with the engine that works here: Docker when `docker info`
 # answers, else podman with docker/containers.conf (docker/engine.sh). IMAGE names it.

@@ -57,12 +57,12 @@ struct GatewayConfig {
   int rt_priority = 0;  ///< SCHED_FIFO priority 1..99, with mlockall; 0: off
   int cpu = -1;         ///< pin the ingress thread to this CPU; -1: off
 
-  // ROS 2 naming (docs: README "ROS 2"): rt/<ros2_namespace>/<topic> with rsg_msgs type names,
+  // ROS 2 naming (docs/ros2.md): rt/<ros2_namespace>/<topic> with rsg_msgs type names,
   // status on gateway_status, egress on robot_state_cmd unless --egress-topic says otherwise
   bool ros2 = false;
   std::string ros2_namespace;  ///< "" or e.g. "/robot1"
 
-  // Standard ROS 2 topics (README "ROS 2"), each off ("") or at a RATE: "HZ" (at most HZ a second)
+  // Standard ROS 2 topics (docs/ros2.md), each off ("") or at a RATE: "HZ" (at most HZ a second)
   // or "every:N" (every Nth frame that carries what the topic needs)
   std::string joint_states;     ///< sensor_msgs/JointState from q, dq, tau_J
   std::string tf;               ///< tf2_msgs/TFMessage base_frame -> ee_frame from O_T_EE

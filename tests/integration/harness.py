@@ -141,7 +141,7 @@ class Harness:
 
     def secure_profiles(self):
         """A fresh test PKI, and a directory with rsg's profiles and the PKI's participant profiles
-        (rsg_secure_gateway, _reader, _intruder, _commander), as the README tells operators to make."""
+        (rsg_secure_gateway, _reader, _intruder, _commander), as docs/security.md tells operators to make."""
         source = Path(__file__).resolve().parents[2] / "xml_profiles"
         pki = self.dir / "pki"
         subprocess.run([source / "security/make_test_pki.sh", pki], check=True, stdout=subprocess.DEVNULL)

@@ -1,4 +1,4 @@
-"""The secure deployment the README shows, end to end: rsg_gateway and rsg_echo with the test PKI's
+"""The secure deployment docs/security.md shows, end to end: rsg_gateway and rsg_echo with the test PKI's
 participant profiles. The authenticated, permitted reader gets every frame exactly; a plain
 rsg_echo on the same domain, started first, is never matched and prints nothing."""
 

@@ -40,7 +40,7 @@ DISCOVERY_SERVER_PROFILE = (Path(__file__).resolve().parents[2] / "xml_profiles"
 
 
 def discovery_server_argv(port):
-    """`fastdds discovery` on gw as the README deploys it: server id 0, with rsg's server profile."""
+    """`fastdds discovery` on gw as docs/deploying.md deploys it: server id 0, with rsg's server profile."""
     return ["fastdds", "discovery", "-i", "0", "-l", HOSTS["gw"], "-p", str(port), "-x", str(DISCOVERY_SERVER_PROFILE)]
 
 

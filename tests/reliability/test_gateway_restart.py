@@ -46,7 +46,7 @@ def body(h):
     gateway, stats, port = start_gateway(h, RATE_HZ)
     # Not data-sharing: a SIGKILL while the gateway notifies a data-sharing reader leaves that
     # reader's notification mutex locked, and Fast DDS 2.9.1 then throws in the reader and in the
-    # next gateway (README, "Operating it safely"). What this test pins is the restart.
+    # next gateway (docs/operating.md). What this test pins is the restart.
     probe = DeadlineProbe(h, qos="reader_realtime_udp")
     logger = start_logger(h, "logger")
     wait_for_readers(stats, 2)

@@ -19,7 +19,7 @@
 
 namespace {
 
-// The gateway's port in the README's examples and the Docker image (EXPOSE 17000/udp).
+// The gateway's port in the guides' examples and the Docker image (EXPOSE 17000/udp).
 constexpr unsigned kDocumentedGatewayPort = 17000;
 constexpr std::string_view kPlaceholder = "@RSG_GENERATED_TABLES@";
 
