@@ -6,8 +6,8 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <stdexcept>
 
-#include "rsg/dds/robot_state.hpp"
 #include "ros2_type_hash.hpp"
+#include "rsg/dds/robot_state.hpp"
 
 namespace rsg::gateway {
 namespace {

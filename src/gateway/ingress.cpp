@@ -156,7 +156,7 @@ void Ingress::handle(const DatagramBatch::Datagram& datagram, Clock::time_point 
   // same pass as the CRC check. A rejected frame's sample goes back unwritten.
   // With an in-process consumer the frame is decoded into the preallocated sample, not a loan:
   // loaning takes the writer's lock, which Fast DDS's event thread may hold, and the consumer
-  // must not wait for it. write() then copies the sample into the writer's history (~0.1 us).
+  // must not wait for it. write() then copies the sample into the writer's history.
   SampleSlot slot(*writer_, writer_loans_ && !options_.on_sample, fallback_sample_);
   const DecodeResult decoded = codec_.decode(datagram.bytes, slot.sample());
   if (!decoded) {

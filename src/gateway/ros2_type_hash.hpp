@@ -31,7 +31,8 @@ inline std::string_view ros2_type_hash(std::string_view type_name) {
 
 /// Puts "typehash=<hash>;" of `type_name` into `user_data` (replacing what was there) when the hash
 /// is known; leaves it alone otherwise.
-inline void announce_ros2_type_hash(eprosima::fastdds::dds::UserDataQosPolicy& user_data, std::string_view type_name) {
+inline void announce_ros2_type_hash(eprosima::fastdds::dds::UserDataQosPolicy& user_data,
+                                    std::string_view type_name) {
   const std::string_view hash = ros2_type_hash(type_name);
   if (hash.empty()) return;
   const std::string text = "typehash=" + std::string(hash) + ";";
@@ -39,24 +40,26 @@ inline void announce_ros2_type_hash(eprosima::fastdds::dds::UserDataQosPolicy& u
 }
 
 /// create_datawriter_with_profile, with the topic type's hash announced when it has one.
-inline eprosima::fastdds::dds::DataWriter* create_writer_with_profile(eprosima::fastdds::dds::Publisher& publisher,
-                                                                      eprosima::fastdds::dds::Topic* topic,
-                                                                      const std::string& profile) {
+inline eprosima::fastdds::dds::DataWriter* create_writer_with_profile(
+    eprosima::fastdds::dds::Publisher& publisher, eprosima::fastdds::dds::Topic* topic,
+    const std::string& profile) {
   eprosima::fastdds::dds::DataWriterQos qos;
   if (ros2_type_hash(topic->get_type_name()).empty() ||
-      publisher.get_datawriter_qos_from_profile(profile, qos) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+      publisher.get_datawriter_qos_from_profile(profile, qos) !=
+          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
     return publisher.create_datawriter_with_profile(topic, profile);
   announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
   return publisher.create_datawriter(topic, qos);
 }
 
 /// create_datareader_with_profile, with the topic type's hash announced when it has one.
-inline eprosima::fastdds::dds::DataReader* create_reader_with_profile(eprosima::fastdds::dds::Subscriber& subscriber,
-                                                                      eprosima::fastdds::dds::Topic* topic,
-                                                                      const std::string& profile) {
+inline eprosima::fastdds::dds::DataReader* create_reader_with_profile(
+    eprosima::fastdds::dds::Subscriber& subscriber, eprosima::fastdds::dds::Topic* topic,
+    const std::string& profile) {
   eprosima::fastdds::dds::DataReaderQos qos;
   if (ros2_type_hash(topic->get_type_name()).empty() ||
-      subscriber.get_datareader_qos_from_profile(profile, qos) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+      subscriber.get_datareader_qos_from_profile(profile, qos) !=
+          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
     return subscriber.create_datareader_with_profile(topic, profile);
   announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
   return subscriber.create_datareader(topic, qos);

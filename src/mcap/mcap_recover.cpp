@@ -28,7 +28,8 @@ class Copier final : public RecordVisitor {
     if (schema == schemas_.end()) return;  // no schema (id 0) or an unknown one: its messages are unreadable
     std::vector<std::pair<std::string, std::string>> metadata;
     for (const auto& [key, value] : channel.metadata) metadata.emplace_back(key, value);
-    channels_[channel.id] = writer->add_channel(schema->second, channel.topic, channel.message_encoding, metadata);
+    channels_[channel.id] =
+        writer->add_channel(schema->second, channel.topic, channel.message_encoding, metadata);
   }
   bool on_message(const Message& message) override {
     const auto channel = channels_.find(message.channel_id);
@@ -36,7 +37,8 @@ class Copier final : public RecordVisitor {
       ++unreadable;
       return true;
     }
-    writer->write(channel->second, message.sequence, message.log_time, message.publish_time, message.data.bytes);
+    writer->write(channel->second, message.sequence, message.log_time, message.publish_time,
+                  message.data.bytes);
     return true;
   }
 
@@ -56,8 +58,7 @@ RecoverResult recover(std::span<const std::uint8_t> damaged, const std::filesyst
   Copier copier(out, std::move(options));
   RecoverResult result;
   result.scan = scan(damaged, copier);
-  if (!copier.writer)
-    throw std::runtime_error("not an MCAP file (no header): " + result.scan.error);
+  if (!copier.writer) throw std::runtime_error("not an MCAP file (no header): " + result.scan.error);
   copier.writer->close();
   result.written = copier.writer->totals();
   result.unreadable = copier.unreadable;

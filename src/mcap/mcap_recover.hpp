@@ -17,9 +17,9 @@
 namespace rsg::mcap {
 
 struct RecoverResult {
-  ScanResult scan;                ///< how far the damaged file read (truncated: a killed writer's file)
-  WriterTotals written;           ///< what the new file holds
-  std::uint64_t unreadable = 0;   ///< messages on a channel the file never described (left out)
+  ScanResult scan;               ///< how far the damaged file read (truncated: a killed writer's file)
+  WriterTotals written;          ///< what the new file holds
+  std::uint64_t unreadable = 0;  ///< messages on a channel the file never described (left out)
 };
 
 /// Writes what `damaged` holds to `out` (profile and library from its header; `options` for the

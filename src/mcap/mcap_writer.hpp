@@ -8,11 +8,11 @@
 //   writer.close();  // or let the destructor finish the file
 //
 // Crash safety: a schema or channel goes into the open chunk, ahead of the messages that use it (as
-// MCAP's own writers do; `mcap recover` copies such chunks as they are), and every finished chunk goes to the kernel at once (write(2)), so a writer killed with SIGKILL
-// leaves a file that a reader scanning records front to back can read up to its last finished
-// chunk (with `sync`, a machine that loses power too). When a write fails (disk full, file size limit) the
-// file is cut back to its last whole record and, where the freed space allows, finished with a summary; the
-// error is then thrown.
+// MCAP's own writers do; `mcap recover` copies such chunks as they are), and every finished chunk goes to the
+// kernel at once (write(2)), so a writer killed with SIGKILL leaves a file that a reader scanning records
+// front to back can read up to its last finished chunk (with `sync`, a machine that loses power too). When a
+// write fails (disk full, file size limit) the file is cut back to its last whole record and, where the freed
+// space allows, finished with a summary; the error is then thrown.
 #pragma once
 
 #include <cstdint>
@@ -129,7 +129,8 @@ class Writer {
 
   // The open chunk: its records, and per channel the (log_time, offset) of each message in it.
   std::vector<std::uint8_t> chunk_;
-  std::vector<std::pair<bool, std::size_t>> chunk_definitions_;  // (schema?, index): what the open chunk carries
+  std::vector<std::pair<bool, std::size_t>>
+      chunk_definitions_;                 // (schema?, index): what the open chunk carries
   std::vector<TimeOffsets> chunk_index_;  // indexed by channel id
   std::uint64_t chunk_start_ = 0, chunk_end_ = 0;
   std::uint64_t chunk_messages_ = 0;

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "discovery_cli.hpp"
 #include "monitor_readers.hpp"
 #include "rsg/dds/discovery.hpp"
-#include "rsg/dds/discovery_cli.hpp"
 #include "rsg/dds/profiles.hpp"
 
 namespace rsg::tools {

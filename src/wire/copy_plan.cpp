@@ -1,4 +1,4 @@
-#include "rsg/wire/copy_plan.hpp"
+#include "rsg/wire/detail/copy_plan.hpp"
 
 #include <algorithm>
 

@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <span>
 
-#include "rsg/wire/copy_plan.hpp"
+#include "rsg/wire/detail/copy_plan.hpp"
 
 namespace rsg::detail {
 

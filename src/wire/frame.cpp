@@ -98,7 +98,7 @@ bool check_header(std::uint8_t request, const Selection& selection, FrameError& 
 }
 
 // Checks 4..6 when they pass, the common case, without branches: check_header's branches and
-// error messages cost ~2 ns per frame, which shows on a CPU whose CRC takes 28 ns. check_header
+// error messages show in the codec's cost next to a fast CRC (docs/benchmarks/wire.md). check_header
 // still runs when this says no, to name the first failure.
 bool header_passes(std::uint8_t request, const Selection& selection) {
   constexpr std::uint64_t kLow7 = 0x7F7F'7F7F'7F7F;  // per data_select byte

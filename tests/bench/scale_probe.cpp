@@ -30,8 +30,8 @@
 #include <iostream>
 #include <vector>
 
+#include "discovery_cli.hpp"
 #include "e2e/stamped_frames.hpp"
-#include "rsg/dds/discovery_cli.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"

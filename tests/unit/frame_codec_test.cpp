@@ -17,8 +17,8 @@
 
 #include "crc32_copy.hpp"
 #include "random_state.hpp"
-#include "rsg/wire/copy_plan.hpp"
 #include "rsg/wire/crc32.hpp"
+#include "rsg/wire/detail/copy_plan.hpp"
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/state_values.hpp"
 

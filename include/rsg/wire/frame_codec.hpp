@@ -5,16 +5,15 @@
 //   if (!result) { count(result.error().category()); return; }   // `sample` holds garbage: drop it
 //
 // The same checks and results as `decode` followed by `copy_fields`, and `encode`, but the copy
-// and the CRC happen in the same pass over the bytes (see src/wire/crc32_copy.hpp): a full frame
-// costs 1.4 x the CRC alone instead of 2.2 x on an AMD Zen 4, and 1.9 x on an Intel Xeon whose
-// CRC is twice as fast (docs/benchmarks/wire.md). The codec keeps the copy plan of the last
-// selection it saw.
+// and the CRC happen in the same pass over the bytes (see src/wire/crc32_copy.hpp), which costs
+// much less than two passes (measured in docs/benchmarks/wire.md). The codec keeps the copy plan
+// of the last selection it saw.
 #pragma once
 
 #include <cstdint>
 #include <span>
 
-#include "rsg/wire/copy_plan.hpp"
+#include "rsg/wire/detail/copy_plan.hpp"
 #include "rsg/wire/field_layout.hpp"
 #include "rsg/wire/frame.hpp"
 

@@ -21,9 +21,9 @@
 #include <stop_token>
 #include <thread>
 
+#include "discovery_cli.hpp"
 #include "live_table.hpp"
 #include "matched_writers.hpp"
-#include "rsg/dds/discovery_cli.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"

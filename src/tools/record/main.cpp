@@ -13,13 +13,13 @@
 #include <map>
 #include <optional>
 
+#include "discovery_cli.hpp"
 #include "matched_writers.hpp"
 #include "mcap_recover.hpp"
 #include "mcap_writer.hpp"
 #include "monitor_options.hpp"
 #include "monitor_readers.hpp"
 #include "recording.hpp"
-#include "rsg/dds/discovery_cli.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
@@ -178,8 +178,8 @@ class Recording {
     batch_bytes_.insert(batch_bytes_.end(), payload.begin(), payload.end());
   }
 
-  void write(std::uint16_t channel, std::uint32_t sequence, std::uint64_t log_time, std::uint64_t publish_time,
-             std::span<const std::uint8_t> payload) {
+  void write(std::uint16_t channel, std::uint32_t sequence, std::uint64_t log_time,
+             std::uint64_t publish_time, std::span<const std::uint8_t> payload) {
     // After a split the next file is opened by the next message, so that none is left empty.
     if (!writer_) open();
     writer_->write(channel, sequence, log_time, publish_time, payload);
@@ -223,9 +223,10 @@ void add_options(CLI::App& app, Options& options) {
   app.add_option("--duration", options.duration_s,
                  "Stop after this many seconds (default: until SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--recover", options.recover,
-                 "Do not record: write what FILE (a recording whose recorder was killed) holds up to its last "
-                 "whole chunk to --out as a finished, indexed file, and exit")
+  app.add_option(
+         "--recover", options.recover,
+         "Do not record: write what FILE (a recording whose recorder was killed) holds up to its last "
+         "whole chunk to --out as a finished, indexed file, and exit")
       ->check(CLI::ExistingFile);
   app.add_option("--split-size", options.split_mb,
                  "Start a new file when one reaches this many MB: FILE_0.mcap, FILE_1.mcap, ...")
@@ -245,19 +246,19 @@ void add_options(CLI::App& app, Options& options) {
 /// truncated or whole, 1 when it is damaged inside (what came before the damage is still written).
 int recover(const Options& options) {
   const rsg::mcap::MappedFile damaged(options.recover);
-  const auto result = rsg::mcap::recover(
-      damaged.bytes(), options.out, {.chunk_bytes = options.chunk_bytes, .sync = options.fsync});
+  const auto result = rsg::mcap::recover(damaged.bytes(), options.out,
+                                         {.chunk_bytes = options.chunk_bytes, .sync = options.fsync});
   using Status = rsg::mcap::ScanResult::Status;
   std::cerr << "rsg_record: recovered " << result.written.messages << " messages in " << result.written.chunks
             << " chunks from " << options.recover.string() << " into " << options.out.string();
   if (result.unreadable > 0) std::cerr << "; left out " << result.unreadable << " on undescribed channels";
   std::cerr << "\n";
   if (result.scan.status == Status::truncated)
-    std::cerr << "rsg_record: " << options.recover.string() << " ends early (" << result.scan.error << " at byte "
-              << result.scan.offset << "): everything before it was recovered\n";
+    std::cerr << "rsg_record: " << options.recover.string() << " ends early (" << result.scan.error
+              << " at byte " << result.scan.offset << "): everything before it was recovered\n";
   if (result.scan.status == Status::malformed) {
-    std::cerr << "rsg_record: " << options.recover.string() << " is damaged at byte " << result.scan.offset << ": "
-              << result.scan.error << "; what came before was recovered\n";
+    std::cerr << "rsg_record: " << options.recover.string() << " is damaged at byte " << result.scan.offset
+              << ": " << result.scan.error << "; what came before was recovered\n";
     return kExitFailure;
   }
   return kExitOk;
@@ -333,7 +334,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Records RobotState and GatewayStatus samples into an MCAP file.", "rsg_record"};
   app.footer(
       "Exit status: 0 after --duration or on SIGINT/SIGTERM (the file finished), 1 when the file cannot be "
-      "written (what was recorded stays readable) or DDS fails, 2 usage error. --recover: 0 when FILE read to "
+      "written (what was recorded stays readable) or DDS fails, 2 usage error. --recover: 0 when FILE read "
+      "to "
       "its end or was cut off, 1 when it is damaged inside.");
   Options options;
   add_options(app, options);

@@ -18,9 +18,9 @@
 #include <thread>
 #include <unordered_set>
 
+#include "discovery_cli.hpp"
 #include "mcap_reader.hpp"
 #include "recording.hpp"
-#include "rsg/dds/discovery_cli.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"

@@ -1,5 +1,5 @@
-// The command-line options of rsg/dds/discovery.hpp, the same on every rsg program (needs CLI11,
-// header-only):
+// The command-line options of rsg/dds/discovery.hpp, the same on every rsg program. The tools' own
+// glue, not rsg's API, so that CLI11 stays out of the installed headers:
 //
 //   rsg::DiscoveryOptions discovery;
 //   rsg::add_discovery_options(app, discovery);

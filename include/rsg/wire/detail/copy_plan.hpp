@@ -1,3 +1,4 @@
+// Internal, not rsg's API (FrameCodec holds one by value, so its header must see it).
 // Which bytes go where when one selection's fields move between a frame and a struct.
 //
 // The field walk (44 rows: present? where on the wire? where in the struct?) is done once per
