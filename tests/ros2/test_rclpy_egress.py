@@ -6,14 +6,13 @@ a uint64 time above 2^63 survive). The graph API shows the gateway's egress read
 subscription of rsg_msgs/msg/RobotState, reliable and volatile, with rosidl's type hash.
 """
 import json
-import socket
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
-from harness import check, main, wait_for_stats  # noqa: E402
+from harness import check, main  # noqa: E402
 from rclpy_common import RosEnv, group_present, hash_hint, start_peer  # noqa: E402
-from test_ros2_egress import check_egress, command_records, encode  # noqa: E402
+from test_ros2_egress import check_egress, command_records, egress_gateway, encode  # noqa: E402
 
 
 def message_of(record, member_order):
@@ -35,12 +34,7 @@ def body(h):
     messages = h.dir / "cmd.messages.jsonl"
     messages.write_text("".join(json.dumps(message_of(r, order)) + "\n" for r in records))
 
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sink:
-        sink.bind(("127.0.0.1", 0))
-        sink.settimeout(30)
-        gateway, stats = h.gateway("gateway", "--ros2", "--ros2-namespace", "/robot1",
-                                   "--send-to", f"127.0.0.1:{sink.getsockname()[1]}")
-        wait_for_stats(stats, lambda s: True, "the gateway to start")
+    with egress_gateway(h) as (sink, gateway, stats):
         publisher = start_peer(h, env, "publisher", "pub", "/robot1/robot_state_cmd", "rsg_msgs/msg/RobotState",
                                "--file", messages, "--timeout", 60)
         # The node publishes once its publisher matched the gateway's reader and exits 0 only when

@@ -4,6 +4,7 @@ each sample as the raw frame it describes, byte for byte what rsg_frame makes of
 
 Needs RSG_ROS2_ECHO (rsg_ros2_cyclone_echo) in the environment; ctest sets it.
 """
+import contextlib
 import json
 import os
 import socket
@@ -35,6 +36,19 @@ def encode(h, records):
     return source, expected
 
 
+@contextlib.contextmanager
+def egress_gateway(h):
+    """A started gateway in /robot1 that sends robot_state_cmd's samples to this test's UDP sink:
+    yields (sink, gateway, stats)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sink:
+        sink.bind(("127.0.0.1", 0))
+        sink.settimeout(30)
+        gateway, stats = h.gateway("gateway", "--ros2", "--ros2-namespace", "/robot1",
+                                   "--send-to", f"127.0.0.1:{sink.getsockname()[1]}")
+        wait_for_stats(stats, lambda s: True, "the gateway to start")
+        yield sink, gateway, stats
+
+
 def check_egress(h, sink, expected, stats, gateway):
     """The sink got exactly the expected frames, in order; the gateway counted them and exits 0."""
     for index, frame in enumerate(expected):
@@ -54,12 +68,7 @@ def body(h):
     ros2_echo = os.environ.get("RSG_ROS2_ECHO")
     check(ros2_echo and Path(ros2_echo).exists(), "RSG_ROS2_ECHO must name rsg_ros2_cyclone_echo")
     source, expected = encode(h, command_records())
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sink:
-        sink.bind(("127.0.0.1", 0))
-        sink.settimeout(30)
-        gateway, stats = h.gateway("gateway", "--ros2", "--ros2-namespace", "/robot1",
-                                   "--send-to", f"127.0.0.1:{sink.getsockname()[1]}")
-        wait_for_stats(stats, lambda s: True, "the gateway to start")
+    with egress_gateway(h) as (sink, gateway, stats):
         publisher = h.run("publisher", [ros2_echo, str(h.domain), "rt/robot1/robot_state_cmd", "publish", str(source)],
                           timeout_s=120)
         check(publisher == 0, "the ROS 2 publisher's samples were not all acknowledged by the gateway")
