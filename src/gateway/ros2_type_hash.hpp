@@ -13,6 +13,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "rsg_ros2_type_hashes.hpp"
 
@@ -21,9 +22,13 @@ namespace rsg::gateway {
 /// The hash rosidl computed for a ROS 2 type, by its DDS name ("rsg_msgs::msg::dds_::RobotState_") or
 /// its ROS name ("rsg_msgs/msg/RobotState"); "" when unknown (not a ROS 2 type, or no hashes built).
 inline std::string_view ros2_type_hash(std::string_view type_name) {
+  constexpr std::string_view kDdsInfix = "::msg::dds_::";  // pkg::msg::dds_::Type_ is pkg/msg/Type
   std::string ros_name(type_name);
-  if (const auto dds = ros_name.find("::msg::dds_::"); dds != std::string::npos && ros_name.ends_with('_'))
-    ros_name = ros_name.substr(0, dds) + "/msg/" + ros_name.substr(dds + 13, ros_name.size() - dds - 14);
+  if (const auto dds = ros_name.find(kDdsInfix); dds != std::string::npos && ros_name.ends_with('_')) {
+    const std::size_t type_start = dds + kDdsInfix.size();
+    ros_name =
+        ros_name.substr(0, dds) + "/msg/" + ros_name.substr(type_start, ros_name.size() - 1 - type_start);
+  }
   for (const auto& [name, hash] : ros2_generated::kTypeHashes)
     if (name == ros_name) return hash;
   return {};
