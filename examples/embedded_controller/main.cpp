@@ -1,4 +1,4 @@
-// A controller with the gateway inside: rsg::EmbeddedGateway hands each validated robot state to
+// A controller with the gateway inside: rsg::gateway::EmbeddedGateway hands each validated robot state to
 // this process on the ingress thread -- no socket and no DDS hop in between -- while the same
 // states are still published on DDS for views, recorders and ROS 2.
 //
@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
   std::atomic<std::uint64_t> frames{0};
 
   try {
-    rsg::EmbeddedGateway gateway(read_file(argv[1]), [&](const rsg::RobotState& state) {
+    rsg::gateway::EmbeddedGateway gateway(read_file(argv[1]), [&](const rsg::RobotState& state) {
       Received& slot = newest.back();
       slot.state = state;  // one 2.3 kB copy: plain data, no allocation
       slot.at = std::chrono::steady_clock::now();

@@ -8,7 +8,7 @@
 #include <memory>
 #include <stdexcept>
 
-namespace rsg {
+namespace rsg::dds {
 namespace {
 
 using eprosima::fastrtps::rtps::IPLocator;
@@ -42,8 +42,8 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
   for (std::size_t index = 0; index < options.servers.size(); ++index) {
     const std::string& value = options.servers[index];
     auto id = static_cast<unsigned>(index);
-    HostPort server;
-    if (auto error = split_discovery_server(value, id, server); !error.empty())
+    transport::HostPort server;
+    if (auto error = transport::split_discovery_server(value, id, server); !error.empty())
       throw std::invalid_argument(error);
     eprosima::fastdds::rtps::RemoteServerAttributes remote;
     eprosima::fastdds::rtps::get_server_client_default_guidPrefix(static_cast<int>(id), remote.guidPrefix);
@@ -70,19 +70,20 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
 
   const auto& ports = qos.wire_protocol().port;
   for (const std::string& value : options.peers) {
-    HostPort peer;
-    if (auto error = split_host_port(value, HostPortRule::kPortOptional, peer); !error.empty())
+    transport::HostPort peer;
+    if (auto error = transport::split_host_port(value, transport::HostPortRule::kPortOptional, peer);
+        !error.empty())
       throw std::invalid_argument(error);
     const std::string address = resolve_ipv4(peer.host, value);
     if (peer.port != 0) {
       builtin.initialPeersList.push_back(udp_locator(address, peer.port));
       continue;
     }
-    for (std::uint32_t id = 0; id < kGatewayParticipantIds; ++id)
+    for (std::uint32_t id = 0; id < transport::kGatewayParticipantIds; ++id)
       builtin.initialPeersList.push_back(
           udp_locator(address, ports.portBase + ports.domainIDGain * static_cast<std::uint32_t>(domain) +
                                    ports.offsetd1 + ports.participantIDGain * id));
   }
 }
 
-}  // namespace rsg
+}  // namespace rsg::dds

@@ -7,7 +7,8 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <stdexcept>
 
-namespace rsg {
+namespace rsg::dds {
+namespace fdds = eprosima::fastdds::dds;
 
 Participant::Participant(int domain, const std::string& profile) {
   auto* factory = fdds::DomainParticipantFactory::get_instance();
@@ -91,4 +92,4 @@ fdds::Subscriber* Participant::subscriber(const std::vector<std::string>& partit
   return created;
 }
 
-}  // namespace rsg
+}  // namespace rsg::dds

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace rsg {
+namespace rsg::dds {
 namespace {
 
 std::filesystem::path running_binary_dir() {
@@ -61,4 +61,4 @@ void load_profiles(const std::vector<std::string>& files_or_dirs, const std::str
     throw std::runtime_error("no participant profile named '" + participant_profile + "'");
 }
 
-}  // namespace rsg
+}  // namespace rsg::dds

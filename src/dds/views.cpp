@@ -7,12 +7,13 @@
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/selection.hpp"
 
-namespace rsg {
+namespace rsg::dds {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 using eprosima::fastrtps::rtps::PropertyPolicyHelper;
 
-constexpr std::uint8_t kValidGroupBits = (1U << kGroupCount) - 1;
+constexpr std::uint8_t kValidGroupBits = (1U << wire::kGroupCount) - 1;
 
 void check_groups(std::uint8_t groups) {
   if (groups == 0) throw ViewError("a view needs at least one group");
@@ -46,7 +47,7 @@ fdds::ContentFilteredTopic* find_or_create_filtered_topic(fdds::DomainParticipan
 std::string group_filter_expression(std::uint8_t groups) {
   check_groups(groups);
   std::string expression;
-  for (std::size_t group = 0; group < kGroupCount; ++group) {
+  for (std::size_t group = 0; group < wire::kGroupCount; ++group) {
     if (((groups >> group) & 1U) == 0) continue;
     if (!expression.empty()) expression += " AND ";
     expression += "group_present[" + std::to_string(group) + "] = TRUE";
@@ -56,7 +57,7 @@ std::string group_filter_expression(std::uint8_t groups) {
 
 View group_view(std::uint8_t groups) {
   View view{.name = "groups", .groups = groups, .filter = group_filter_expression(groups)};
-  for (std::size_t group = 0; group < kGroupCount; ++group)
+  for (std::size_t group = 0; group < wire::kGroupCount; ++group)
     if ((groups >> group) & 1U) view.name += "_" + std::to_string(group);
   return view;
 }
@@ -77,7 +78,7 @@ View parse_view(const std::string& profile, const fdds::DataReaderQos& qos) {
   }
   std::uint8_t mask = 0;
   std::string error;
-  if (!parse_group_mask(*groups, mask, error))
+  if (!wire::parse_group_mask(*groups, mask, error))
     throw ViewError(where + kViewGroupsProperty + " = \"" + *groups + "\": " + error);
   return View{.name = profile, .groups = mask, .filter = group_filter_expression(mask)};
 }
@@ -123,4 +124,4 @@ ViewReader::~ViewReader() {
   filtered_topic_->get_participant()->delete_contentfilteredtopic(filtered_topic_);
 }
 
-}  // namespace rsg
+}  // namespace rsg::dds

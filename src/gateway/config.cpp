@@ -22,13 +22,13 @@ std::string join(const std::vector<std::string>& items) {
 }
 
 // Syntax only (rsg/transport/host_port.hpp): names are resolved when the gateway starts.
-std::string check_host_port(const std::string& value, HostPortRule rule) {
-  HostPort parsed;
-  return split_host_port(value, rule, parsed);
+std::string check_host_port(const std::string& value, transport::HostPortRule rule) {
+  transport::HostPort parsed;
+  return transport::split_host_port(value, rule, parsed);
 }
 
 std::string check_optional_host_port(const std::string& value) {
-  return value.empty() ? std::string() : check_host_port(value, HostPortRule::kPortRequired);
+  return value.empty() ? std::string() : check_host_port(value, transport::HostPortRule::kPortRequired);
 }
 
 std::string check_not_empty(const std::string& value) { return value.empty() ? "must not be empty" : ""; }
@@ -54,7 +54,8 @@ std::string check_frame(const std::string& value) {
 const std::array kKeys = {
     ConfigKey{"listen", "Receive raw frames on HOST:PORT (UDP) and publish them", &GatewayConfig::listen,
               [](const GatewayConfig& c) {
-                return c.listen.empty() ? "" : check_host_port(c.listen, HostPortRule::kPortMayBeZero);
+                return c.listen.empty() ? ""
+                                        : check_host_port(c.listen, transport::HostPortRule::kPortMayBeZero);
               }},
     ConfigKey{"allow-from", "Accept frames only from ADDR[/PREFIX] (repeatable; IPv4 or IPv6)",
               &GatewayConfig::allow_from,
@@ -92,7 +93,8 @@ const std::array kKeys = {
     ConfigKey{"send-to", "Destination HOST:PORT of egress frames (repeatable)", &GatewayConfig::send_to,
               [](const GatewayConfig& c) {
                 for (const auto& destination : c.send_to)
-                  if (auto error = check_host_port(destination, HostPortRule::kPortRequired); !error.empty())
+                  if (auto error = check_host_port(destination, transport::HostPortRule::kPortRequired);
+                      !error.empty())
                     return error;
                 return std::string();
               }},
@@ -101,21 +103,22 @@ const std::array kKeys = {
         &GatewayConfig::robot, [](const GatewayConfig& c) { return check_optional_host_port(c.robot); }},
     ConfigKey{"request-groups", "Ask the robot for these groups, e.g. 2,5", &GatewayConfig::request_groups,
               [](const GatewayConfig& c) {
-                Selection ignored;
+                wire::Selection ignored;
                 std::string error;
-                return c.request_groups.empty() || parse_group_list(join(c.request_groups), ignored, error)
+                return c.request_groups.empty() ||
+                               wire::parse_group_list(join(c.request_groups), ignored, error)
                            ? std::string()
                            : error;
               }},
-    ConfigKey{"request-fields", "Ask the robot for these fields, e.g. q,dq,time",
-              &GatewayConfig::request_fields,
-              [](const GatewayConfig& c) {
-                Selection ignored;
-                std::string error;
-                return c.request_fields.empty() || parse_field_list(join(c.request_fields), ignored, error)
-                           ? std::string()
-                           : error;
-              }},
+    ConfigKey{
+        "request-fields", "Ask the robot for these fields, e.g. q,dq,time", &GatewayConfig::request_fields,
+        [](const GatewayConfig& c) {
+          wire::Selection ignored;
+          std::string error;
+          return c.request_fields.empty() || wire::parse_field_list(join(c.request_fields), ignored, error)
+                     ? std::string()
+                     : error;
+        }},
     ConfigKey{"status-topic", "Topic of the GatewayStatus samples", &GatewayConfig::status_topic,
               [](const GatewayConfig& c) { return check_not_empty(c.status_topic); }},
     ConfigKey{"expected-rate",
@@ -179,7 +182,7 @@ const std::array kKeys = {
               &GatewayConfig::ros2_namespace,
               [](const GatewayConfig& c) {
                 if (!c.ros2_namespace.empty() && !c.ros2) return std::string("needs --ros2");
-                return check_ros2_namespace(c.ros2_namespace);
+                return dds::check_ros2_namespace(c.ros2_namespace);
               }},
     ConfigKey{
         "joint-states",
@@ -221,10 +224,12 @@ const std::array kKeys = {
               [](const GatewayConfig& c) { return check_not_empty(c.reader_profile); }},
     ConfigKey{"status-profile", "XML data writer profile of the status topic", &GatewayConfig::status_profile,
               [](const GatewayConfig& c) { return check_not_empty(c.status_profile); }},
-    ConfigKey{"discovery-server", kDiscoveryServerHelp, &GatewayConfig::discovery_servers,
-              [](const GatewayConfig& c) { return check_each(c.discovery_servers, check_discovery_server); }},
-    ConfigKey{"peer", kPeerHelp, &GatewayConfig::peers,
-              [](const GatewayConfig& c) { return check_each(c.peers, check_peer); }},
+    ConfigKey{"discovery-server", transport::kDiscoveryServerHelp, &GatewayConfig::discovery_servers,
+              [](const GatewayConfig& c) {
+                return check_each(c.discovery_servers, transport::check_discovery_server);
+              }},
+    ConfigKey{"peer", transport::kPeerHelp, &GatewayConfig::peers,
+              [](const GatewayConfig& c) { return check_each(c.peers, transport::check_peer); }},
 };
 
 const ConfigKey* find_key(std::string_view name) {
@@ -242,7 +247,7 @@ std::string known_keys() {
 template <class Number>
 std::string read_number(const YAML::Node& node, Number& out) {
   const std::string& text = node.Scalar();
-  const std::optional<Number> number = parse_number<Number>(text);
+  const std::optional<Number> number = wire::parse_number<Number>(text);
   if (!number) return "'" + text + "' is not " + (std::is_integral_v<Number> ? "an integer" : "a number");
   out = *number;
   return {};
@@ -370,23 +375,23 @@ std::optional<Decimation> parse_decimation(const std::string& value) {
   constexpr std::string_view kEvery = "every:";
   if (value.starts_with(kEvery)) {
     const std::string_view n = std::string_view(value).substr(kEvery.size());
-    const std::optional<std::uint32_t> every = parse_number<std::uint32_t>(n);
+    const std::optional<std::uint32_t> every = wire::parse_number<std::uint32_t>(n);
     if (!every || *every < 1 || *every > 1'000'000) return std::nullopt;
     return Decimation{*every, {}};
   }
-  const std::optional<double> hz = parse_number<double>(value);
+  const std::optional<double> hz = wire::parse_number<double>(value);
   if (!hz || !(*hz > 0 && *hz <= 10000)) return std::nullopt;
   return Decimation{0, std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / *hz))};
 }
 
-Selection requested_selection(const GatewayConfig& config) {
-  Selection selection;
+wire::Selection requested_selection(const GatewayConfig& config) {
+  wire::Selection selection;
   std::string ignored;
-  if (!config.request_groups.empty()) parse_group_list(join(config.request_groups), selection, ignored);
+  if (!config.request_groups.empty()) wire::parse_group_list(join(config.request_groups), selection, ignored);
   if (!config.request_fields.empty()) {
-    Selection fields;
-    parse_field_list(join(config.request_fields), fields, ignored);
-    for (const FieldInfo& field : kFields)
+    wire::Selection fields;
+    wire::parse_field_list(join(config.request_fields), fields, ignored);
+    for (const wire::FieldInfo& field : wire::kFields)
       if (fields.contains(field.id())) selection.add(field.id());
   }
   return selection;

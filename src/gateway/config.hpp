@@ -74,7 +74,7 @@ struct GatewayConfig {
   std::string wrench_frame = "panda_link0";  ///< as franka_ros2's state broadcaster: O is link0
 
   // Fast DDS XML profiles
-  std::string profiles;  ///< empty: rsg::default_profiles_dir()
+  std::string profiles;  ///< empty: rsg::dds::default_profiles_dir()
   std::string participant_profile = "rsg_participant";
   std::string writer_profile = "rsg_state_writer";
   std::string reader_profile = "rsg_state_reader";
@@ -144,6 +144,6 @@ std::optional<RateTopic> parse_rate_topic(const std::string& value);
 std::optional<Decimation> parse_decimation(const std::string& value);
 
 /// The selection `request-groups` and `request-fields` ask for together (assumes a checked config).
-Selection requested_selection(const GatewayConfig& config);
+wire::Selection requested_selection(const GatewayConfig& config);
 
 }  // namespace rsg::gateway

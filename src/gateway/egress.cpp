@@ -10,6 +10,7 @@
 #include "rsg/dds/robot_state.hpp"
 
 namespace rsg::gateway {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 // How long the thread sleeps without samples before it looks at its log again.
@@ -17,9 +18,9 @@ const eprosima::fastrtps::Duration_t kIdleWake{1, 0};
 
 }  // namespace
 
-Egress::Egress(Participant& participant, const Options& options) : participant_(participant) {
-  for (const Endpoint& endpoint : options.destinations)
-    destinations_.push_back({endpoint, UdpSocket::for_sending_to(endpoint)});
+Egress::Egress(dds::Participant& participant, const Options& options) : participant_(participant) {
+  for (const transport::Endpoint& endpoint : options.destinations)
+    destinations_.push_back({endpoint, transport::UdpSocket::for_sending_to(endpoint)});
 
   subscriber_ = participant_.subscriber(options.partitions);
   fdds::Topic* topic = participant_.robot_state_topic(options.topic, options.type_name);
@@ -77,7 +78,7 @@ void Egress::forward_available() {
 
 void Egress::forward(const RobotState& sample) {
   samples_.fetch_add(1, std::memory_order_relaxed);
-  const EncodeResult encoded = codec_.encode(sample, frame_);
+  const wire::EncodeResult encoded = codec_.encode(sample, frame_);
   if (!encoded) {
     unencodable_.fetch_add(1, std::memory_order_relaxed);
     last_encode_error_ = encoded.error;

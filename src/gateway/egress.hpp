@@ -28,14 +28,14 @@ class Egress {
  public:
   struct Options {
     std::string topic;
-    std::string type_name;  ///< "" : rsg::RobotState; else e.g. rsg::kRos2RobotStateType
+    std::string type_name;  ///< "" : rsg::RobotState; else e.g. rsg::dds::kRos2RobotStateType
     std::vector<std::string> partitions;
     std::string reader_profile;
-    std::vector<Endpoint> destinations;
+    std::vector<transport::Endpoint> destinations;
   };
 
   /// Creates the reader and the sockets, then starts the thread. Throws std::runtime_error.
-  Egress(Participant& participant, const Options& options);
+  Egress(dds::Participant& participant, const Options& options);
   /// Stops the thread, then deletes the reader.
   ~Egress();
   Egress(const Egress&) = delete;
@@ -48,8 +48,8 @@ class Egress {
 
  private:
   struct Destination {
-    Endpoint endpoint;
-    UdpSocket socket;
+    transport::Endpoint endpoint;
+    transport::UdpSocket socket;
   };
 
   void run();
@@ -57,15 +57,15 @@ class Egress {
   void forward(const RobotState& sample);
   void log_unencodable();
 
-  Participant& participant_;
-  fdds::Subscriber* subscriber_ = nullptr;
-  fdds::DataReader* reader_ = nullptr;
+  dds::Participant& participant_;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
   std::vector<Destination> destinations_;
-  std::array<std::uint8_t, kMaxFrameBytes> frame_{};
-  RobotStateCodec codec_;  // used by the forwarding thread only
+  std::array<std::uint8_t, wire::kMaxFrameBytes> frame_{};
+  dds::RobotStateCodec codec_;  // used by the forwarding thread only
 
-  fdds::WaitSet waitset_;
-  fdds::GuardCondition stop_;
+  eprosima::fastdds::dds::WaitSet waitset_;
+  eprosima::fastdds::dds::GuardCondition stop_;
 
   // Written by the egress thread only, read by the status loop.
   std::atomic<std::uint64_t> samples_{0};
@@ -73,7 +73,7 @@ class Egress {
   std::atomic<std::uint64_t> unencodable_{0};
   std::atomic<std::uint64_t> send_failed_{0};
   // Egress thread only: the rate-limited log of samples that are no valid frame.
-  FrameError last_encode_error_;
+  wire::FrameError last_encode_error_;
   std::uint64_t logged_unencodable_ = 0;
   LogThrottle unencodable_log_{std::chrono::seconds(1)};
 

@@ -9,7 +9,7 @@
 #include "config.hpp"
 #include "gateway.hpp"
 
-namespace rsg {
+namespace rsg::gateway {
 namespace {
 
 // Everything rsg_gateway checks before it creates anything, plus the one thing embedding needs.
@@ -57,7 +57,7 @@ class EmbeddedGateway::Impl {
     stop_.store(true, std::memory_order_relaxed);
     if (thread_.joinable()) thread_.join();
   }
-  Endpoint local_endpoint() const { return *gateway_.ingress_endpoint(); }
+  transport::Endpoint local_endpoint() const { return *gateway_.ingress_endpoint(); }
 
  private:
   gateway::GatewaySetup setup_;
@@ -72,11 +72,11 @@ EmbeddedGateway::~EmbeddedGateway() = default;
 EmbeddedGateway::EmbeddedGateway(EmbeddedGateway&&) noexcept = default;
 EmbeddedGateway& EmbeddedGateway::operator=(EmbeddedGateway&&) noexcept = default;
 
-Endpoint EmbeddedGateway::local_endpoint() const {
+transport::Endpoint EmbeddedGateway::local_endpoint() const {
   if (!impl_) throw std::logic_error("EmbeddedGateway::local_endpoint after stop()");
   return impl_->local_endpoint();
 }
 
 void EmbeddedGateway::stop() { impl_.reset(); }
 
-}  // namespace rsg
+}  // namespace rsg::gateway

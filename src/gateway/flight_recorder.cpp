@@ -24,7 +24,8 @@ std::string utc_stamp(std::chrono::system_clock::time_point now) {
 
 }  // namespace
 
-FlightRecorder::FlightRecorder(const Options& options, const Endpoint& listen, const DatagramBatch& batch)
+FlightRecorder::FlightRecorder(const Options& options, const transport::Endpoint& listen,
+                               const transport::DatagramBatch& batch)
     : options_(options),
       listen_(capture::endpoint_of(listen.address())),
       slot_bytes_(batch.buffer_bytes()),
@@ -35,16 +36,16 @@ FlightRecorder::FlightRecorder(const Options& options, const Endpoint& listen, c
   entries_.resize(slots_);
 }
 
-void FlightRecorder::lend(DatagramBatch& batch) {
+void FlightRecorder::lend(transport::DatagramBatch& batch) {
   for (std::size_t i = 0; i < batch.capacity(); ++i)
     batch.receive_into(i, {slot((next_ + i) % slots_), slot_bytes_});
 }
 
-void FlightRecorder::commit(const DatagramBatch& batch, std::size_t received,
+void FlightRecorder::commit(const transport::DatagramBatch& batch, std::size_t received,
                             std::chrono::system_clock::time_point now) {
   const auto time = std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch());
   for (std::size_t i = 0; i < received; ++i) {
-    const DatagramBatch::Datagram datagram = batch[i];
+    const transport::DatagramBatch::Datagram datagram = batch[i];
     Entry& entry = entries_[(next_ + i) % slots_];
     entry.time = time;
     entry.size = static_cast<std::uint32_t>(datagram.bytes.size());

@@ -34,7 +34,8 @@ class FlightRecorder {
 
   /// `listen`: the gateway's address, the destination in the dumps. `batch`: the receive batch the
   /// ring lends its slots to; one datagram of it takes at most `batch.buffer_bytes()`.
-  FlightRecorder(const Options& options, const Endpoint& listen, const DatagramBatch& batch);
+  FlightRecorder(const Options& options, const transport::Endpoint& listen,
+                 const transport::DatagramBatch& batch);
   FlightRecorder(const FlightRecorder&) = delete;
   FlightRecorder& operator=(const FlightRecorder&) = delete;
 
@@ -42,9 +43,10 @@ class FlightRecorder {
   std::size_t capacity() const { return kept_capacity_; }
 
   /// Before a receive: the batch's datagrams will land in the ring's next free slots.
-  void lend(DatagramBatch& batch);
+  void lend(transport::DatagramBatch& batch);
   /// After it: the `received` datagrams of `batch` become the newest entries, seen at `now`.
-  void commit(const DatagramBatch& batch, std::size_t received, std::chrono::system_clock::time_point now);
+  void commit(const transport::DatagramBatch& batch, std::size_t received,
+              std::chrono::system_clock::time_point now);
 
   /// Writes the datagrams of the last `window` before the newest one, oldest first, to
   /// DIR/rsg_flight_<UTC time>_<N>_<reason>.pcap. Throws std::runtime_error when it cannot.

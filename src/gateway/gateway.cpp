@@ -20,6 +20,7 @@
 #include "rsg/dds/ros2.hpp"
 
 namespace rsg::gateway {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 using std::chrono::milliseconds;
@@ -31,9 +32,9 @@ constexpr auto kSummaryPeriod = std::chrono::seconds(10);
 // The longest the loop sleeps: bounds how late it notices a stop request or a due status.
 constexpr milliseconds kLongestWait{100};
 
-Endpoint resolve(const std::string& flag, const std::string& host_port) {
+transport::Endpoint resolve(const std::string& flag, const std::string& host_port) {
   try {
-    return Endpoint::parse(host_port);
+    return transport::Endpoint::parse(host_port);
   } catch (const std::invalid_argument& error) {
     throw std::runtime_error("--" + flag + ": " + error.what());
   }
@@ -41,8 +42,8 @@ Endpoint resolve(const std::string& flag, const std::string& host_port) {
 
 void load_and_check_profiles(const GatewayConfig& config) {
   const std::filesystem::path profiles =
-      config.profiles.empty() ? default_profiles_dir() : std::filesystem::path(config.profiles);
-  load_profiles(profiles);
+      config.profiles.empty() ? dds::default_profiles_dir() : std::filesystem::path(config.profiles);
+  dds::load_profiles(profiles);
 
   // Fast DDS only notices a missing profile when an entity is created from it; look first.
   eprosima::fastrtps::ParticipantAttributes participant;
@@ -77,9 +78,10 @@ fdds::DomainParticipantQos participant_qos(const GatewayConfig& config) {
       ReturnCode_t::RETCODE_OK)
     throw std::runtime_error("no participant profile named '" + profile + "'");
   if (qos.wire_protocol().participant_id < 0)
-    qos.wire_protocol().participant_id = static_cast<std::int32_t>(::getpid() % kGatewayParticipantIds);
+    qos.wire_protocol().participant_id =
+        static_cast<std::int32_t>(::getpid() % transport::kGatewayParticipantIds);
   try {
-    apply_discovery({config.discovery_servers, config.peers}, config.domain, qos);
+    dds::apply_discovery({config.discovery_servers, config.peers}, config.domain, qos);
   } catch (const std::invalid_argument& error) {
     throw std::runtime_error(std::string("--discovery-server/--peer: ") + error.what());
   }
@@ -92,15 +94,15 @@ std::vector<std::string> partitions_of(const GatewayConfig& config) {
 
 // The DDS topic of a configured topic name: itself, or its ROS 2 name in the namespace.
 std::string dds_topic(const GatewayConfig& config, const std::string& name) {
-  return config.ros2 ? ros2_topic_name(config.ros2_namespace, name) : name;
+  return config.ros2 ? dds::ros2_topic_name(config.ros2_namespace, name) : name;
 }
 
 std::string state_type_name(const GatewayConfig& config) {
-  return config.ros2 ? std::string(kRos2RobotStateType) : std::string();
+  return config.ros2 ? std::string(dds::kRos2RobotStateType) : std::string();
 }
 
 std::string status_topic_of(const GatewayConfig& config) {
-  return config.ros2 ? ros2_topic_name(config.ros2_namespace, "gateway_status") : config.status_topic;
+  return config.ros2 ? dds::ros2_topic_name(config.ros2_namespace, "gateway_status") : config.status_topic;
 }
 
 // joint_states and external_wrench in the namespace; tf absolute (/tf), where tf2 and RViz listen.
@@ -177,7 +179,7 @@ Gateway::Gateway(const GatewaySetup& setup)
     : config_(setup.config),
       participant_(config_.domain, participant_qos(config_)),
       status_(participant_, status_topic_of(config_), partitions_of(config_), config_.status_profile,
-              config_.ros2 ? std::string(kRos2GatewayStatusType) : std::string()) {
+              config_.ros2 ? std::string(dds::kRos2GatewayStatusType) : std::string()) {
   if (setup.ingress) {
     ingress_.emplace(participant_, *setup.ingress);
     spdlog::info("ingress: frames on UDP {} -> topic '{}' (domain {})",

@@ -37,7 +37,7 @@ class Gateway {
   void run(const std::atomic<bool>& stop, std::atomic<bool>* dump = nullptr);
 
   /// Where ingress receives frames; nothing when there is no ingress.
-  std::optional<Endpoint> ingress_endpoint() const {
+  std::optional<transport::Endpoint> ingress_endpoint() const {
     return ingress_ ? std::optional(ingress_->local_endpoint()) : std::nullopt;
   }
 
@@ -49,7 +49,7 @@ class Gateway {
   void write_stats_file(const GatewayStats& stats) const;
 
   GatewayConfig config_;
-  Participant participant_;  // first: outlives every entity below
+  dds::Participant participant_;  // first: outlives every entity below
   StatusPublisher status_;
   std::optional<Ingress> ingress_;
   std::optional<Egress> egress_;

@@ -8,10 +8,11 @@
 #include "ros2_type_hash.hpp"
 
 namespace rsg::gateway {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
-std::optional<std::uint64_t> frame_time(const FrameView& frame) {
-  const auto bytes = frame.field_bytes(Field::time);
+std::optional<std::uint64_t> frame_time(const wire::FrameView& frame) {
+  const auto bytes = frame.field_bytes(wire::Field::time);
   if (bytes.empty()) return std::nullopt;
   std::uint64_t value = 0;
   for (std::size_t i = 0; i < bytes.size(); ++i)
@@ -57,11 +58,11 @@ class SampleSlot {
 
 }  // namespace
 
-Ingress::Ingress(Participant& participant, Options options)
+Ingress::Ingress(dds::Participant& participant, Options options)
     : options_(std::move(options)),
-      socket_(UdpSocket::bind(options_.listen)),
+      socket_(transport::UdpSocket::bind(options_.listen)),
       participant_(participant),
-      batch_(kBatchDatagrams, kMaxFrameBytes),
+      batch_(kBatchDatagrams, wire::kMaxFrameBytes),
       sequence_(options_.restart_threshold_ms),
       link_(options_.nominal_period) {
   if (options_.receive_buffer > 0) {
@@ -134,7 +135,7 @@ void Ingress::receive(std::chrono::milliseconds timeout) {
   }
 }
 
-void Ingress::handle(const DatagramBatch::Datagram& datagram, Clock::time_point now) {
+void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::time_point now) {
   if (!options_.sources.allows(datagram.from.address())) {
     ++counters_.rejected_source;
     last_foreign_sender_ = datagram.from;
@@ -147,8 +148,8 @@ void Ingress::handle(const DatagramBatch::Datagram& datagram, Clock::time_point 
   // (length_mismatch); only a forged length field above kMaxDataBytes that matches the real size
   // and fails the CRC would rank bad_crc first, and the cut-off bytes cannot tell.
   if (datagram.truncated) {
-    reject({ErrorCategory::kLengthMismatch, "%zu bytes, longer than any frame (%zu)", datagram.size,
-            kMaxFrameBytes},
+    reject({wire::ErrorCategory::kLengthMismatch, "%zu bytes, longer than any frame (%zu)", datagram.size,
+            wire::kMaxFrameBytes},
            datagram.from);
     return;
   }
@@ -158,12 +159,12 @@ void Ingress::handle(const DatagramBatch::Datagram& datagram, Clock::time_point 
   // loaning takes the writer's lock, which Fast DDS's event thread may hold, and the consumer
   // must not wait for it. write() then copies the sample into the writer's history.
   SampleSlot slot(*writer_, writer_loans_ && !options_.on_sample, fallback_sample_);
-  const DecodeResult decoded = codec_.decode(datagram.bytes, slot.sample());
+  const wire::DecodeResult decoded = codec_.decode(datagram.bytes, slot.sample());
   if (!decoded) {
     reject(decoded.error(), datagram.from);
     return;
   }
-  const FrameView& frame = decoded.frame();
+  const wire::FrameView& frame = decoded.frame();
 
   const std::optional<std::uint64_t> robot_time_ms = frame_time(frame);
   sequence_.observe(frame.packet_number(), robot_time_ms);
@@ -194,17 +195,18 @@ void Ingress::write_rate_topics(const RobotState& sample, std::chrono::nanosecon
       rate.writer->write(const_cast<RobotState*>(&sample));  // a copy into the writer's own history
 }
 
-void Ingress::reject(const FrameError& error, const Endpoint& sender) {
+void Ingress::reject(const wire::FrameError& error, const transport::Endpoint& sender) {
   ++counters_.invalid[invalid_index(error.category())];
   last_rejection_ = error;
   last_rejected_sender_ = sender;
 }
 
-void Ingress::request_selection(const Endpoint& robot, Clock::time_point) {
-  std::array<std::uint8_t, kSelectionRequestBytes> request{};
-  const EncodeResult encoded =
+void Ingress::request_selection(const transport::Endpoint& robot, Clock::time_point) {
+  std::array<std::uint8_t, wire::kSelectionRequestBytes> request{};
+  const wire::EncodeResult encoded =
       encode_selection_request(request_packet_number_, requester_->wanted(), request);
-  request_packet_number_ = static_cast<std::uint8_t>((request_packet_number_ + 1) % kPacketNumberModulo);
+  request_packet_number_ =
+      static_cast<std::uint8_t>((request_packet_number_ + 1) % wire::kPacketNumberModulo);
   // From the listening socket, so that the robot's answer (its stream) comes back to it. Rare (at
   // most once a second), so it may log.
   if (encoded && socket_.send_to(std::span(request).first(encoded.size), robot))
@@ -251,7 +253,7 @@ void Ingress::log_rejections() {
   }
   if (any)
     spdlog::warn("rejected invalid frames: {}; the last from {}: {}: {}", format_invalid(fresh),
-                 last_rejected_sender_.to_string(), to_string(last_rejection_.category()),
+                 last_rejected_sender_.to_string(), wire::to_string(last_rejection_.category()),
                  last_rejection_.message());
   logged_invalid_ = counters_.invalid;
 

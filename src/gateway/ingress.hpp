@@ -33,17 +33,17 @@ namespace rsg::gateway {
 class Ingress {
  public:
   struct Options {
-    Endpoint listen;
+    transport::Endpoint listen;
     int receive_buffer = 0;
     SourceFilter sources;
     std::string topic;
-    std::string type_name;  ///< "" : rsg::RobotState; else e.g. rsg::kRos2RobotStateType
+    std::string type_name;  ///< "" : rsg::RobotState; else e.g. rsg::dds::kRos2RobotStateType
     std::vector<std::string> partitions;
     std::string writer_profile;
     Clock::duration nominal_period{};
     std::uint64_t restart_threshold_ms = 0;
-    std::optional<Selection> requested_selection;
-    std::optional<Endpoint> robot;  ///< where selection requests go; unset: the frames' source
+    std::optional<wire::Selection> requested_selection;
+    std::optional<transport::Endpoint> robot;  ///< where selection requests go; unset: the frames' source
     std::optional<FlightRecorder::Options> flight_recorder;  ///< keep the last seconds of datagrams
     /// Downsampled copies: each topic gets the frames that fall due at its period (same type).
     struct RateTopic {
@@ -55,12 +55,12 @@ class Ingress {
     /// thread of their own from snapshots the ingress thread leaves (ros2_standard_topics.hpp).
     std::optional<Ros2StandardTopics::Options> standard_topics;
     /// Called on the ingress thread with every valid sample just before it is written, so an
-    /// in-process consumer (rsg::EmbeddedGateway) gets it without a socket or a DDS hop.
+    /// in-process consumer (rsg::gateway::EmbeddedGateway) gets it without a socket or a DDS hop.
     std::function<void(const RobotState&)> on_sample;
   };
 
   /// Binds the socket and creates the writer. Throws std::runtime_error / std::system_error.
-  Ingress(Participant& participant, Options options);
+  Ingress(dds::Participant& participant, Options options);
   ~Ingress();
   Ingress(const Ingress&) = delete;
   Ingress& operator=(const Ingress&) = delete;
@@ -89,7 +89,7 @@ class Ingress {
   /// Logs one line when frames were rejected since the last call (the caller calls it once a second).
   void log_rejections();
 
-  Endpoint local_endpoint() const { return socket_.local_endpoint(); }
+  transport::Endpoint local_endpoint() const { return socket_.local_endpoint(); }
 
   /// Writes the flight recorder's datagrams as a pcap file; nothing when it is off. Allocates and
   /// writes a file: call it on a request or a link change, not per frame. Throws std::runtime_error.
@@ -102,29 +102,29 @@ class Ingress {
   }
 
  private:
-  void handle(const DatagramBatch::Datagram& datagram, Clock::time_point now);
-  void reject(const FrameError& error, const Endpoint& sender);
-  void request_selection(const Endpoint& robot, Clock::time_point now);
+  void handle(const transport::DatagramBatch::Datagram& datagram, Clock::time_point now);
+  void reject(const wire::FrameError& error, const transport::Endpoint& sender);
+  void request_selection(const transport::Endpoint& robot, Clock::time_point now);
   void write_rate_topics(const RobotState& sample, std::chrono::nanoseconds t);
 
   // A downsampled writer: writes the frames its decimator takes.
   struct RateWriter {
-    fdds::DataWriter* writer = nullptr;
+    eprosima::fastdds::dds::DataWriter* writer = nullptr;
     Decimator decimator;
   };
 
   Options options_;
-  UdpSocket socket_;
-  Participant& participant_;
-  fdds::Publisher* publisher_ = nullptr;
-  fdds::DataWriter* writer_ = nullptr;
+  transport::UdpSocket socket_;
+  dds::Participant& participant_;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
   bool writer_loans_ = false;
   std::vector<RateWriter> rate_writers_;
   std::optional<Ros2StandardTopics> standard_topics_;  // before publisher_ goes
 
   // One frame per buffer: anything longer arrives marked truncated and is rejected unread.
-  DatagramBatch batch_;
-  RobotStateCodec codec_;
+  transport::DatagramBatch batch_;
+  dds::RobotStateCodec codec_;
   RobotState fallback_sample_;  // when the writer cannot loan: the one preallocated sample
 
   IngressCounters counters_;
@@ -135,13 +135,13 @@ class Ingress {
   std::optional<SelectionRequester> requester_;
   std::uint8_t request_packet_number_ = 0;
 
-  Endpoint source_;  // sender of the last valid frame
-  FrameError last_rejection_;
-  Endpoint last_rejected_sender_;
+  transport::Endpoint source_;  // sender of the last valid frame
+  wire::FrameError last_rejection_;
+  transport::Endpoint last_rejected_sender_;
   InvalidCounts logged_invalid_{};
   std::uint64_t logged_rejected_source_ = 0;
   std::uint64_t logged_standard_dropped_ = 0;
-  Endpoint last_foreign_sender_;
+  transport::Endpoint last_foreign_sender_;
 };
 
 }  // namespace rsg::gateway

@@ -12,6 +12,7 @@
 #include "rsg/dds/eigen.hpp"
 
 namespace rsg::gateway {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 namespace ros_time = builtin_interfaces::msg::dds_;
@@ -66,7 +67,8 @@ struct Ros2StandardTopics::Messages {
   geometry::WrenchStamped_ wrench;
 };
 
-Ros2StandardTopics::Ros2StandardTopics(Participant& participant, fdds::Publisher& publisher, Options options)
+Ros2StandardTopics::Ros2StandardTopics(dds::Participant& participant, fdds::Publisher& publisher,
+                                       Options options)
     : options_(std::move(options)),
       participant_(participant),
       publisher_(publisher),
@@ -115,14 +117,14 @@ std::array<std::uint64_t, 3> Ros2StandardTopics::written() const {
   return {joint_states_.written.load(), tf_.written.load(), wrench_.written.load()};
 }
 
-void Ros2StandardTopics::offer(const RobotState& sample, const Selection& selection,
+void Ros2StandardTopics::offer(const RobotState& sample, const wire::Selection& selection,
                                std::chrono::nanoseconds t) noexcept {
   std::uint8_t outputs = 0;
   // A decimator counts only the frames its output could publish.
-  if (joint_states_.decimator && selection.contains(Field::q) && joint_states_.decimator->due(t))
+  if (joint_states_.decimator && selection.contains(wire::Field::q) && joint_states_.decimator->due(t))
     outputs |= kJointStates;
-  if (tf_.decimator && selection.contains(Field::O_T_EE) && tf_.decimator->due(t)) outputs |= kTf;
-  if (wrench_.decimator && selection.contains(Field::O_F_ext_hat_K) && wrench_.decimator->due(t))
+  if (tf_.decimator && selection.contains(wire::Field::O_T_EE) && tf_.decimator->due(t)) outputs |= kTf;
+  if (wrench_.decimator && selection.contains(wire::Field::O_F_ext_hat_K) && wrench_.decimator->due(t))
     outputs |= kWrench;
   if (outputs == 0) return;
 
@@ -138,8 +140,8 @@ void Ros2StandardTopics::offer(const RobotState& sample, const Selection& select
   slot.outputs = outputs;
   if (outputs & kJointStates) {
     slot.q = sample.q();
-    slot.has_dq = selection.contains(Field::dq);
-    slot.has_tau = selection.contains(Field::tau_J);
+    slot.has_dq = selection.contains(wire::Field::dq);
+    slot.has_tau = selection.contains(wire::Field::tau_J);
     slot.dq = sample.dq();
     slot.tau_J = sample.tau_J();
   }
@@ -186,7 +188,7 @@ void Ros2StandardTopics::publish(const Snapshot& snapshot) {
   if (snapshot.outputs & kTf) {
     geometry::TransformStamped_& transform = tf_message.transforms()[0];
     transform.header().stamp(stamp);
-    const auto pose = eigen::pose(snapshot.O_T_EE);  // column-major, as the frame stores it
+    const auto pose = dds::eigen::pose(snapshot.O_T_EE);  // column-major, as the frame stores it
     transform.transform().translation(vector3(pose(0, 3), pose(1, 3), pose(2, 3)));
     // A measured rotation is orthonormal to within rounding; normalising keeps the quaternion a
     // unit one (tf2 rejects others) whatever the last bits say.

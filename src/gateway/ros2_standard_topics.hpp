@@ -45,7 +45,8 @@ class Ros2StandardTopics {
   };
 
   /// Creates the writers in `publisher` and starts the publishing thread. Throws std::runtime_error.
-  Ros2StandardTopics(Participant& participant, fdds::Publisher& publisher, Options options);
+  Ros2StandardTopics(dds::Participant& participant, eprosima::fastdds::dds::Publisher& publisher,
+                     Options options);
   /// Stops the thread (what is queued is still written), then deletes the writers.
   ~Ros2StandardTopics();
   Ros2StandardTopics(const Ros2StandardTopics&) = delete;
@@ -53,7 +54,7 @@ class Ros2StandardTopics {
 
   /// Ingress thread, per valid frame: takes what falls due for each output whose fields the frame
   /// carries. `t` paces the rates (the robot's time, else arrival). Allocates nothing.
-  void offer(const RobotState& sample, const Selection& selection, std::chrono::nanoseconds t) noexcept;
+  void offer(const RobotState& sample, const wire::Selection& selection, std::chrono::nanoseconds t) noexcept;
 
   /// Snapshots dropped because the publishing thread was behind by a whole ring.
   std::uint64_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
@@ -80,7 +81,7 @@ class Ros2StandardTopics {
   };
 
   struct Writer {
-    fdds::DataWriter* writer = nullptr;
+    eprosima::fastdds::dds::DataWriter* writer = nullptr;
     std::optional<Decimator> decimator;
     std::atomic<std::uint64_t> written{0};
   };
@@ -89,11 +90,11 @@ class Ros2StandardTopics {
 
   void run();
   void publish(const Snapshot& snapshot);
-  void create(Writer& writer, const std::optional<Output>& output, fdds::TypeSupport type);
+  void create(Writer& writer, const std::optional<Output>& output, eprosima::fastdds::dds::TypeSupport type);
 
   Options options_;
-  Participant& participant_;
-  fdds::Publisher& publisher_;
+  dds::Participant& participant_;
+  eprosima::fastdds::dds::Publisher& publisher_;
   Writer joint_states_;
   Writer tf_;
   Writer wrench_;

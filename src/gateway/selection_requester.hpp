@@ -13,16 +13,17 @@ namespace rsg::gateway {
 
 class SelectionRequester {
  public:
-  explicit SelectionRequester(const Selection& wanted, Clock::duration min_interval = std::chrono::seconds(1))
+  explicit SelectionRequester(const wire::Selection& wanted,
+                              Clock::duration min_interval = std::chrono::seconds(1))
       : wanted_(wanted), min_interval_(min_interval) {}
 
-  const Selection& wanted() const { return wanted_; }
+  const wire::Selection& wanted() const { return wanted_; }
 
   /// True for the start-up request (the first call). Records the request as sent.
   bool start_up_due(Clock::time_point now) { return record_if(!requested_once_, now); }
 
   /// True when a frame carrying `seen` should trigger a new request. Records the request as sent.
-  bool due(const Selection& seen, Clock::time_point now) {
+  bool due(const wire::Selection& seen, Clock::time_point now) {
     return record_if(seen != wanted_ && (!requested_once_ || now - last_request_ >= min_interval_), now);
   }
 
@@ -35,7 +36,7 @@ class SelectionRequester {
     return condition;
   }
 
-  Selection wanted_;
+  wire::Selection wanted_;
   Clock::duration min_interval_;
   Clock::time_point last_request_{};
   bool requested_once_ = false;

@@ -5,7 +5,7 @@
 namespace rsg::gateway {
 namespace {
 
-constexpr unsigned kModulo = kPacketNumberModulo;
+constexpr unsigned kModulo = wire::kPacketNumberModulo;
 constexpr unsigned kWindow = 64;  // bits of `arrived_`; more than any distance a frame can have
 // Without time, a frame further ahead than this may instead be a late one.
 constexpr unsigned kMaxAheadWithoutTime = kModulo / 2;

@@ -61,7 +61,7 @@ std::optional<ParsedNetwork> parse_network(std::string_view text, std::string& e
   unsigned bits = max_bits;
   if (slash != std::string_view::npos) {
     const std::string_view prefix = text.substr(slash + 1);
-    const std::optional<unsigned> number = parse_number<unsigned>(prefix);
+    const std::optional<unsigned> number = wire::parse_number<unsigned>(prefix);
     if (number) bits = *number;
     if (!number || bits > max_bits) {
       error = "'" + std::string(text) + "': prefix must be a number 0.." + std::to_string(max_bits);

@@ -14,7 +14,7 @@ std::uint64_t IngressCounters::invalid_total() const {
 std::string to_json(const GatewayStats& stats) {
   nlohmann::ordered_json invalid = nlohmann::ordered_json::object();
   for (std::size_t i = 0; i < stats.ingress.invalid.size(); ++i)
-    invalid[std::string(to_string(category_at(i)))] = stats.ingress.invalid[i];
+    invalid[std::string(wire::to_string(category_at(i)))] = stats.ingress.invalid[i];
 
   const nlohmann::ordered_json json = {
       {"source", stats.source},
@@ -45,7 +45,7 @@ std::string format_invalid(const InvalidCounts& counts) {
   for (std::size_t i = 0; i < counts.size(); ++i) {
     if (counts[i] == 0) continue;
     if (!text.empty()) text += ' ';
-    text += fmt::format("{}={}", to_string(category_at(i)), counts[i]);
+    text += fmt::format("{}={}", wire::to_string(category_at(i)), counts[i]);
   }
   return text;
 }

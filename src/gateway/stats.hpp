@@ -15,10 +15,14 @@
 namespace rsg::gateway {
 
 /// Per spec validation category (ErrorCategory::kTruncated first), `kNone` excluded.
-using InvalidCounts = std::array<std::uint64_t, kErrorCategoryCount>;
+using InvalidCounts = std::array<std::uint64_t, wire::kErrorCategoryCount>;
 
-constexpr std::size_t invalid_index(ErrorCategory category) { return static_cast<std::size_t>(category) - 1; }
-constexpr ErrorCategory category_at(std::size_t index) { return static_cast<ErrorCategory>(index + 1); }
+constexpr std::size_t invalid_index(wire::ErrorCategory category) {
+  return static_cast<std::size_t>(category) - 1;
+}
+constexpr wire::ErrorCategory category_at(std::size_t index) {
+  return static_cast<wire::ErrorCategory>(index + 1);
+}
 
 struct IngressCounters {
   std::uint64_t received = 0;  ///< datagrams from allowed sources, valid or not

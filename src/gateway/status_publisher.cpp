@@ -10,8 +10,9 @@
 #include "status_sample.hpp"
 
 namespace rsg::gateway {
+namespace fdds = eprosima::fastdds::dds;
 
-StatusPublisher::StatusPublisher(Participant& participant, const std::string& topic,
+StatusPublisher::StatusPublisher(dds::Participant& participant, const std::string& topic,
                                  const std::vector<std::string>& partitions, const std::string& profile,
                                  const std::string& type_name)
     : participant_(participant) {

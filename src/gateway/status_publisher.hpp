@@ -14,8 +14,8 @@ namespace rsg::gateway {
 class StatusPublisher {
  public:
   /// Throws std::runtime_error when the writer cannot be created.
-  /// `type_name` "" keeps the IDL's name (rsg::GatewayStatus), else e.g. rsg::kRos2GatewayStatusType.
-  StatusPublisher(Participant& participant, const std::string& topic,
+  /// `type_name` "" keeps the IDL's name (rsg::GatewayStatus), else e.g. rsg::dds::kRos2GatewayStatusType.
+  StatusPublisher(dds::Participant& participant, const std::string& topic,
                   const std::vector<std::string>& partitions, const std::string& profile,
                   const std::string& type_name = {});
   ~StatusPublisher();
@@ -25,9 +25,9 @@ class StatusPublisher {
   void publish(const GatewayStats& stats);
 
  private:
-  Participant& participant_;
-  fdds::Publisher* publisher_ = nullptr;
-  fdds::DataWriter* writer_ = nullptr;
+  dds::Participant& participant_;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
   GatewayStatus sample_;
 };
 

@@ -20,10 +20,10 @@ struct MonitorOptions {
   std::string status_topic = "rsg_gateway_status";
   std::vector<std::string> partitions;
   std::string view_profile;
-  std::string qos_profile = kLoggerReaderProfile;  // a watcher misses nothing a reliable writer kept
+  std::string qos_profile = dds::kLoggerReaderProfile;  // a watcher misses nothing a reliable writer kept
   std::vector<std::string> profiles;
   std::string participant_profile = "rsg_participant";
-  DiscoveryOptions discovery;
+  dds::DiscoveryOptions discovery;
 
   MonitorTopics topics() const { return {topic, status_topic, partitions, view_profile, qos_profile}; }
 };
@@ -41,7 +41,7 @@ inline void add_monitor_options(CLI::App& app, MonitorOptions& options, const st
                  "View profile, e.g. view_joints: only samples carrying its groups");
   app.add_option("--qos", options.qos_profile, "Reader QoS profile")->capture_default_str();
   app.add_option("--profiles", options.profiles, "XML profile file or directory (repeatable)")
-      ->default_str(default_profiles_dir().string());
+      ->default_str(dds::default_profiles_dir().string());
   app.add_option("--participant-profile", options.participant_profile, "XML participant profile")
       ->capture_default_str();
   add_discovery_options(app, options.discovery);

@@ -35,13 +35,13 @@ struct MonitorTopics {
 class MonitorReaders {
  public:
   /// Throws ViewError for an unusable view profile, std::runtime_error when Fast DDS refuses a reader.
-  MonitorReaders(Participant& participant, const MonitorTopics& topics, WakeUp wake = WakeUp::kOnData) {
+  MonitorReaders(dds::Participant& participant, const MonitorTopics& topics, WakeUp wake = WakeUp::kOnData) {
     namespace fdds = eprosima::fastdds::dds;
     fdds::Topic& topic = *participant.robot_state_topic(topics.topic);
     fdds::Subscriber& subscriber = *participant.subscriber(topics.partitions);
-    const fdds::DataReaderQos qos = load_reader_qos(subscriber, topics.qos_profile);
+    const fdds::DataReaderQos qos = dds::load_reader_qos(subscriber, topics.qos_profile);
     if (!topics.view_profile.empty()) {
-      view_reader_.emplace(subscriber, topic, load_view(subscriber, topics.view_profile), qos);
+      view_reader_.emplace(subscriber, topic, dds::load_view(subscriber, topics.view_profile), qos);
       state_ = view_reader_->get();
     } else {
       state_ = subscriber.create_datareader(&topic, qos);
@@ -81,7 +81,7 @@ class MonitorReaders {
   }
 
  private:
-  std::optional<ViewReader> view_reader_;
+  std::optional<dds::ViewReader> view_reader_;
   eprosima::fastdds::dds::DataReader* state_ = nullptr;
   eprosima::fastdds::dds::DataReader* status_ = nullptr;
   eprosima::fastdds::dds::GuardCondition stop_;

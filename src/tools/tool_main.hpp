@@ -35,7 +35,7 @@ inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** arg
 inline std::optional<int> load_profiles(std::string_view tool, const std::vector<std::string>& files_or_dirs,
                                         const std::string& participant_profile) {
   try {
-    rsg::load_profiles(files_or_dirs, participant_profile);
+    rsg::dds::load_profiles(files_or_dirs, participant_profile);
   } catch (const std::exception& error) {
     std::cerr << tool << ": " << error.what() << '\n';
     return kExitUsage;
@@ -45,13 +45,13 @@ inline std::optional<int> load_profiles(std::string_view tool, const std::vector
 
 /// Runs `body` (which returns the exit status) and turns what it throws into "<tool>: <what>" on
 /// stderr and an exit status: 2 for what the user asked wrongly but could only be found out once
-/// running (an unknown or malformed view or profile: rsg::ViewError; a bad address:
+/// running (an unknown or malformed view or profile: rsg::dds::ViewError; a bad address:
 /// std::invalid_argument), 1 for everything else (DDS, sockets, files).
 template <class Body>
 int run_reporting_errors(std::string_view tool, Body&& body) {
   try {
     return std::forward<Body>(body)();
-  } catch (const rsg::ViewError& error) {
+  } catch (const rsg::dds::ViewError& error) {
     std::cerr << tool << ": " << error.what() << '\n';
     return kExitUsage;
   } catch (const std::invalid_argument& error) {

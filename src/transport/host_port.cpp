@@ -4,7 +4,7 @@
 
 #include "rsg/wire/number.hpp"
 
-namespace rsg {
+namespace rsg::transport {
 
 std::string split_host_port(std::string_view value, HostPortRule rule, HostPort& out) {
   const std::string quoted = "'" + std::string(value) + "'";
@@ -16,7 +16,7 @@ std::string split_host_port(std::string_view value, HostPortRule rule, HostPort&
   }
   if (colon == 0 && rule != HostPortRule::kBindAddress) return quoted + " is not HOST:PORT";
   const bool zero_allowed = rule == HostPortRule::kPortMayBeZero || rule == HostPortRule::kBindAddress;
-  const std::optional<unsigned> port = parse_number<unsigned>(value.substr(colon + 1));
+  const std::optional<unsigned> port = wire::parse_number<unsigned>(value.substr(colon + 1));
   if (!port || *port > 65535 || (*port == 0 && !zero_allowed))
     return quoted + ": port must be a number " + (zero_allowed ? "0" : "1") + "..65535";
   out = HostPort{std::string(value.substr(0, colon)), *port};
@@ -26,7 +26,7 @@ std::string split_host_port(std::string_view value, HostPortRule rule, HostPort&
 std::string split_discovery_server(std::string_view value, unsigned& id, HostPort& out) {
   std::string_view host_port = value;
   if (const std::size_t at = value.find('@'); at != std::string_view::npos) {
-    const std::optional<unsigned> given = parse_number<unsigned>(value.substr(0, at));
+    const std::optional<unsigned> given = wire::parse_number<unsigned>(value.substr(0, at));
     if (!given || *given > 255) return "'" + std::string(value) + "': server id before '@' must be 0..255";
     id = *given;
     host_port = value.substr(at + 1);
@@ -45,4 +45,4 @@ std::string check_peer(const std::string& value) {
   return split_host_port(value, HostPortRule::kPortOptional, parsed);
 }
 
-}  // namespace rsg
+}  // namespace rsg::transport

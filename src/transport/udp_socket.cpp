@@ -13,7 +13,7 @@
 
 #include "rsg/transport/host_port.hpp"
 
-namespace rsg {
+namespace rsg::transport {
 
 Endpoint Endpoint::parse(std::string_view host_port) {
   const std::string text(host_port);
@@ -178,4 +178,4 @@ Endpoint UdpSocket::local_endpoint() const {
   return endpoint;
 }
 
-}  // namespace rsg
+}  // namespace rsg::transport

@@ -13,7 +13,7 @@
 // The per-chunk helpers must inline into the loop: as calls they cost more than the copy saves.
 #define RSG_STITCHED_INLINE RSG_STITCHED __attribute__((always_inline)) inline
 
-namespace rsg::detail {
+namespace rsg::wire::detail {
 namespace {
 
 // Folding moves the running remainder of the CRC (sixteen bytes per 128-bit lane) D bits further
@@ -440,4 +440,4 @@ std::uint32_t gather_crc32(std::span<std::uint8_t> frame, const ChunkedCopyPlan&
                               : gather_crc32_portable(frame, plan, base);
 }
 
-}  // namespace rsg::detail
+}  // namespace rsg::wire::detail

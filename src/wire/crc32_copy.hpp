@@ -13,7 +13,7 @@
 
 #include "rsg/wire/detail/copy_plan.hpp"
 
-namespace rsg::detail {
+namespace rsg::wire::detail {
 
 /// Decoding: returns the CRC-32 of `frame` and copies the bytes of each of the plan's moves to `base`.
 std::uint32_t crc32_scatter(std::span<const std::uint8_t> frame, const ChunkedCopyPlan& plan,
@@ -43,4 +43,4 @@ std::uint32_t crc32_scatter_stitched(std::span<const std::uint8_t> frame, const 
 std::uint32_t gather_crc32_stitched(std::span<std::uint8_t> frame, const ChunkedCopyPlan& plan,
                                     const std::byte* base) noexcept;
 
-}  // namespace rsg::detail
+}  // namespace rsg::wire::detail

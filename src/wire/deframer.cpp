@@ -4,7 +4,7 @@
 
 #include "rsg/wire/crc32.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 Deframer::Scan Deframer::scan_at(std::size_t start) const noexcept {
   const std::size_t available = size_ - start;
@@ -23,4 +23,4 @@ Deframer::Scan Deframer::scan_at(std::size_t start) const noexcept {
   return {Scan::kFrame, size};
 }
 
-}  // namespace rsg
+}  // namespace rsg::wire

@@ -3,7 +3,7 @@
 #include <cstdarg>
 #include <cstdio>
 
-namespace rsg {
+namespace rsg::wire {
 
 FrameError::FrameError(ErrorCategory category, const char* format, ...) : category_(category) {
   va_list args;
@@ -12,4 +12,4 @@ FrameError::FrameError(ErrorCategory category, const char* format, ...) : catego
   va_end(args);
 }
 
-}  // namespace rsg
+}  // namespace rsg::wire

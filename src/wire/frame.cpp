@@ -11,7 +11,7 @@
 #include "rsg/wire/error_flags.hpp"
 #include "rsg/wire/frame_codec.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 static_assert(std::endian::native == std::endian::little,
               "fields are copied as raw little-endian bytes; a big-endian host needs byte swaps");
@@ -429,4 +429,4 @@ SelectionRequestResult decode_selection_request(std::span<const std::uint8_t> by
   return result;
 }
 
-}  // namespace rsg
+}  // namespace rsg::wire

@@ -1,6 +1,6 @@
 #include "rsg/wire/hex.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 std::string to_hex(std::span<const std::uint8_t> bytes) {
   static constexpr char kDigits[] = "0123456789abcdef";
@@ -30,4 +30,4 @@ bool from_hex(std::string_view text, std::vector<std::uint8_t>& out) {
   return true;
 }
 
-}  // namespace rsg
+}  // namespace rsg::wire

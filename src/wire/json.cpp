@@ -7,7 +7,7 @@
 
 #include "rsg/wire/error_flags.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 namespace {
 
 void append_double(double value, std::string& out) {
@@ -258,4 +258,4 @@ bool parse_canonical_json(std::string_view text, StateValues& out, std::string& 
   return true;
 }
 
-}  // namespace rsg
+}  // namespace rsg::wire

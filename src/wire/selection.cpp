@@ -5,7 +5,7 @@
 #include "group_bytes.hpp"
 #include "rsg/wire/number.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 namespace {
 
 template <class OnItem>
@@ -78,4 +78,4 @@ bool parse_group_mask(std::string_view list, std::uint8_t& out, std::string& err
   return true;
 }
 
-}  // namespace rsg
+}  // namespace rsg::wire

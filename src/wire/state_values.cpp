@@ -4,7 +4,7 @@
 
 #include "rsg/wire/frame.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 const FieldLayout& StateValues::layout() {
   static constexpr FieldLayout kLayout = [] {
@@ -49,4 +49,4 @@ void StateValues::assign(const FrameView& frame) {
   copy_fields(frame, storage(), layout());
 }
 
-}  // namespace rsg
+}  // namespace rsg::wire

@@ -26,55 +26,58 @@ namespace {
 /// A valid frame carrying `selection`, and the values it was encoded from.
 class SampleFrame {
  public:
-  explicit SampleFrame(const rsg::Selection& selection) {
+  explicit SampleFrame(const rsg::wire::Selection& selection) {
     values_.packet_number = 5;
     values_.selection = selection;
-    for (const rsg::FieldInfo& field : rsg::kFields) fill(field);
-    bytes_.resize(rsg::kMaxFrameBytes);
-    const rsg::EncodeResult result =
-        rsg::encode(values_.packet_number, selection, values_.storage(), rsg::StateValues::layout(), bytes_);
+    for (const rsg::wire::FieldInfo& field : rsg::wire::kFields) fill(field);
+    bytes_.resize(rsg::wire::kMaxFrameBytes);
+    const rsg::wire::EncodeResult result = rsg::wire::encode(
+        values_.packet_number, selection, values_.storage(), rsg::wire::StateValues::layout(), bytes_);
     if (!result) std::abort();  // a benchmark of a frame that does not encode would measure nothing
     bytes_.resize(result.size);
   }
 
-  const rsg::StateValues& values() const { return values_; }
+  const rsg::wire::StateValues& values() const { return values_; }
   std::span<const std::uint8_t> bytes() const { return bytes_; }
   /// The bytes the trailer's CRC covers: header and data.
-  std::span<const std::uint8_t> crc_covered() const { return bytes().first(bytes_.size() - rsg::kCrcBytes); }
+  std::span<const std::uint8_t> crc_covered() const {
+    return bytes().first(bytes_.size() - rsg::wire::kCrcBytes);
+  }
 
  private:
-  void fill(const rsg::FieldInfo& field) {
+  void fill(const rsg::wire::FieldInfo& field) {
     switch (field.type) {
-      case rsg::ElementType::kFloat64: {
+      case rsg::wire::ElementType::kFloat64: {
         double element = field.index;
         for (double& value : values_.doubles(field.id())) value = element += 0.125;
         break;
       }
-      case rsg::ElementType::kErrorSet:
+      case rsg::wire::ElementType::kErrorSet:
         values_.set_integer(field.id(), 0x15'5555'5555ULL >> field.index % 2);  // every other flag
         break;
-      case rsg::ElementType::kUInt8:
-        values_.set_integer(field.id(), rsg::kMaxRobotMode);
+      case rsg::wire::ElementType::kUInt8:
+        values_.set_integer(field.id(), rsg::wire::kMaxRobotMode);
         break;
-      case rsg::ElementType::kUInt64:
+      case rsg::wire::ElementType::kUInt64:
         values_.set_integer(field.id(), 1'234'567'890'123ULL);
         break;
     }
   }
 
-  rsg::StateValues values_;
+  rsg::wire::StateValues values_;
   std::vector<std::uint8_t> bytes_;
 };
 
-rsg::Selection joints_selection() {
-  rsg::Selection selection;
-  for (const rsg::Field field : {rsg::Field::tau_J, rsg::Field::q, rsg::Field::dq, rsg::Field::time})
+rsg::wire::Selection joints_selection() {
+  rsg::wire::Selection selection;
+  for (const rsg::wire::Field field :
+       {rsg::wire::Field::tau_J, rsg::wire::Field::q, rsg::wire::Field::dq, rsg::wire::Field::time})
     selection.add(field);
   return selection;
 }
 
 const SampleFrame& full_frame() {
-  static const SampleFrame frame(rsg::Selection::all());
+  static const SampleFrame frame(rsg::wire::Selection::all());
   return frame;
 }
 
@@ -88,7 +91,7 @@ void count_bytes(benchmark::State& state, std::size_t bytes_per_iteration) {
 }
 
 void BM_Memcpy(benchmark::State& state, const SampleFrame& frame) {
-  std::array<std::uint8_t, rsg::kMaxFrameBytes> copy{};
+  std::array<std::uint8_t, rsg::wire::kMaxFrameBytes> copy{};
   for (auto _ : state) {
     benchmark::DoNotOptimize(frame.bytes().data());
     std::memcpy(copy.data(), frame.bytes().data(), frame.bytes().size());
@@ -98,7 +101,7 @@ void BM_Memcpy(benchmark::State& state, const SampleFrame& frame) {
 }
 
 void BM_Crc32Isal(benchmark::State& state, const SampleFrame& frame) {
-  for (auto _ : state) benchmark::DoNotOptimize(rsg::crc32(frame.crc_covered()));
+  for (auto _ : state) benchmark::DoNotOptimize(rsg::wire::crc32(frame.crc_covered()));
   count_bytes(state, frame.crc_covered().size());
 }
 
@@ -112,7 +115,7 @@ void BM_Crc32Zlib(benchmark::State& state, const SampleFrame& frame) {
 /// Validation alone: what a receiver that only counts frames pays.
 void BM_DecodeValidateOnly(benchmark::State& state, const SampleFrame& frame) {
   for (auto _ : state) {
-    const rsg::DecodeResult result = rsg::decode(frame.bytes());
+    const rsg::wire::DecodeResult result = rsg::wire::decode(frame.bytes());
     benchmark::DoNotOptimize(&result);
   }
   count_bytes(state, frame.bytes().size());
@@ -120,10 +123,10 @@ void BM_DecodeValidateOnly(benchmark::State& state, const SampleFrame& frame) {
 
 /// What the gateway does per datagram: validate and copy every field into the sample, in one pass.
 void BM_Decode(benchmark::State& state, const SampleFrame& frame) {
-  rsg::StateValues values;
-  rsg::FrameCodec codec(rsg::StateValues::layout());
+  rsg::wire::StateValues values;
+  rsg::wire::FrameCodec codec(rsg::wire::StateValues::layout());
   for (auto _ : state) {
-    const rsg::DecodeResult result = codec.decode(frame.bytes(), values.storage());
+    const rsg::wire::DecodeResult result = codec.decode(frame.bytes(), values.storage());
     if (!result) {
       state.SkipWithError("the sample frame does not decode");
       break;
@@ -153,11 +156,11 @@ void BM_DecodeAtPageEdges(benchmark::State& state, const SampleFrame& frame) {
     std::memcpy(frames[i], frame.bytes().data(), frame.bytes().size());
     structs[i] = page(10 + i) - 8 * i;  // struct start just before a page boundary
   }
-  rsg::FrameCodec codec(rsg::StateValues::layout());
+  rsg::wire::FrameCodec codec(rsg::wire::StateValues::layout());
   std::size_t next = 0;
   for (auto _ : state) {
     const std::size_t i = next++ % frames.size();
-    const rsg::DecodeResult result = codec.decode({frames[i], frame.bytes().size()}, structs[i]);
+    const rsg::wire::DecodeResult result = codec.decode({frames[i], frame.bytes().size()}, structs[i]);
     if (!result) {
       state.SkipWithError("the sample frame does not decode");
       break;
@@ -178,10 +181,10 @@ void BM_DecodeFrameAt(benchmark::State& state, const SampleFrame& frame, std::si
   const auto address = reinterpret_cast<std::uintptr_t>(buffer.data());
   std::uint8_t* placed = buffer.data() + (kLine - address % kLine) % kLine + offset % kLine;
   std::memcpy(placed, frame.bytes().data(), frame.bytes().size());
-  rsg::StateValues values;
-  rsg::FrameCodec codec(rsg::StateValues::layout());
+  rsg::wire::StateValues values;
+  rsg::wire::FrameCodec codec(rsg::wire::StateValues::layout());
   for (auto _ : state) {
-    const rsg::DecodeResult result = codec.decode({placed, frame.bytes().size()}, values.storage());
+    const rsg::wire::DecodeResult result = codec.decode({placed, frame.bytes().size()}, values.storage());
     if (!result) {
       state.SkipWithError("the sample frame does not decode");
       break;
@@ -197,9 +200,9 @@ std::size_t head_padding(const SampleFrame& frame) { return (64 - frame.crc_cove
 
 /// The same in two passes, `decode` then `copy_fields`: what stitching the copy into the CRC saves.
 void BM_DecodeThenCopy(benchmark::State& state, const SampleFrame& frame) {
-  rsg::StateValues values;
+  rsg::wire::StateValues values;
   for (auto _ : state) {
-    const rsg::DecodeResult result = rsg::decode(frame.bytes());
+    const rsg::wire::DecodeResult result = rsg::wire::decode(frame.bytes());
     if (!result) {
       state.SkipWithError("the sample frame does not decode");
       break;
@@ -212,11 +215,11 @@ void BM_DecodeThenCopy(benchmark::State& state, const SampleFrame& frame) {
 }
 
 void BM_Encode(benchmark::State& state, const SampleFrame& frame) {
-  const rsg::StateValues& values = frame.values();
-  rsg::FrameCodec codec(rsg::StateValues::layout());
-  std::array<std::uint8_t, rsg::kMaxFrameBytes> out{};
+  const rsg::wire::StateValues& values = frame.values();
+  rsg::wire::FrameCodec codec(rsg::wire::StateValues::layout());
+  std::array<std::uint8_t, rsg::wire::kMaxFrameBytes> out{};
   for (auto _ : state) {
-    const rsg::EncodeResult result =
+    const rsg::wire::EncodeResult result =
         codec.encode(values.packet_number, values.selection, values.storage(), out);
     benchmark::DoNotOptimize(&result);
     benchmark::ClobberMemory();
@@ -228,7 +231,7 @@ void BM_Encode(benchmark::State& state, const SampleFrame& frame) {
 /// so frames straddle reads. One iteration delivers one frame's worth of bytes and yields one frame.
 void BM_Deframer(benchmark::State& state, const SampleFrame& frame) {
   constexpr std::size_t kReadBytes = 1472;
-  rsg::Deframer deframer;
+  rsg::wire::Deframer deframer;
   benchmark::IterationCount frames = 0;
   const auto count = [&frames](std::span<const std::uint8_t>) { ++frames; };
   for (auto _ : state) {

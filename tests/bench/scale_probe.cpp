@@ -96,22 +96,22 @@ struct ReadOptions {
   std::string out;
   std::size_t capacity = 120'000;  // 2 minutes at 1 kHz
   std::string participant_profile = "rsg_participant";
-  rsg::DiscoveryOptions discovery;
+  rsg::dds::DiscoveryOptions discovery;
 };
 
 int read(const ReadOptions& options) {
   // Blocked before DDS starts its threads, so that only sigwait below ever takes them.
   const sigset_t signals = stop_signals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-  rsg::load_profiles({}, options.participant_profile);
+  rsg::dds::load_profiles({}, options.participant_profile);
   ArrivalLog log(options.capacity);
   {
-    rsg::Participant participant(options.domain, options.participant_profile, options.discovery);
+    rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery);
     fdds::Topic& topic = *participant.robot_state_topic(options.topic);
     fdds::Subscriber& subscriber = *participant.subscriber(options.partitions);
-    fdds::DataReader* reader =
-        subscriber.create_datareader(&topic, rsg::load_reader_qos(subscriber, rsg::kRealtimeReaderProfile),
-                                     &log, fdds::StatusMask::data_available());
+    fdds::DataReader* reader = subscriber.create_datareader(
+        &topic, rsg::dds::load_reader_qos(subscriber, rsg::dds::kRealtimeReaderProfile), &log,
+        fdds::StatusMask::data_available());
     if (reader == nullptr) throw std::runtime_error("cannot create a reader on '" + options.topic + "'");
     int signal = 0;
     sigwait(&signals, &signal);
@@ -132,8 +132,8 @@ struct SendOptions {
 /// stamp), so the average rate holds when the sender is descheduled.
 int send(const SendOptions& options) {
   ::prctl(PR_SET_TIMERSLACK, 1UL);  // the default 50 us slack would bunch frames
-  const rsg::Endpoint to = rsg::Endpoint::parse(options.to);
-  rsg::UdpSocket socket = rsg::UdpSocket::for_sending_to(to);
+  const rsg::transport::Endpoint to = rsg::transport::Endpoint::parse(options.to);
+  rsg::transport::UdpSocket socket = rsg::transport::UdpSocket::for_sending_to(to);
   rsg::bench::StampedFrames frames;
   const double period_ns = 1e9 / options.rate_hz;
   const auto count = static_cast<std::uint64_t>(options.duration_s * options.rate_hz);
@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
       ->add_option("--participant-profile", read_options.participant_profile,
                    "XML participant profile, e.g. rsg_participant_multicast")
       ->capture_default_str();
-  rsg::add_discovery_options(*reader, read_options.discovery);
+  rsg::tools::add_discovery_options(*reader, read_options.discovery);
   CLI11_PARSE(app, argc, argv);
   try {
     return sender->parsed() ? send(send_options) : read(read_options);

@@ -14,28 +14,28 @@
 
 namespace rsg::test {
 
-inline constexpr std::uint8_t kAllGroupSubsets = 1U << kGroupCount;
+inline constexpr std::uint8_t kAllGroupSubsets = 1U << wire::kGroupCount;
 
 /// Sample i selects every field of the groups of bit pattern i % 64; values are random, and
 /// robot_mode is i % 7 so that raw filters on it have something to select.
-inline std::vector<StateValues> mixed_stream(std::size_t count) {
+inline std::vector<wire::StateValues> mixed_stream(std::size_t count) {
   std::mt19937_64 rng(42);
-  std::vector<StateValues> stream;
+  std::vector<wire::StateValues> stream;
   for (std::size_t i = 0; i < count; ++i) {
-    StateValues values = random_state(rng);
-    Selection selection;
-    for (std::size_t group = 0; group < kGroupCount; ++group)
+    wire::StateValues values = random_state(rng);
+    wire::Selection selection;
+    for (std::size_t group = 0; group < wire::kGroupCount; ++group)
       if (((i % kAllGroupSubsets) >> group) & 1U) selection.add_group(group);
     values.selection = selection;
     values.packet_number = static_cast<std::uint8_t>(i % 16);
-    values.set_integer(Field::robot_mode, i % 7);
+    values.set_integer(wire::Field::robot_mode, i % 7);
     // Clear what the new selection does not carry, as a decoded frame would have it.
-    StateValues carried;
+    wire::StateValues carried;
     carried.packet_number = values.packet_number;
     carried.selection = selection;
-    for (const FieldInfo& field : kFields) {
+    for (const wire::FieldInfo& field : wire::kFields) {
       if (!selection.contains(field.id())) continue;
-      if (field.type == ElementType::kFloat64) {
+      if (field.type == wire::ElementType::kFloat64) {
         const auto from = values.doubles(field.id());
         std::copy(from.begin(), from.end(), carried.doubles(field.id()).begin());
       } else {

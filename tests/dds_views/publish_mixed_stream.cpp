@@ -44,8 +44,8 @@ int main(int argc, char** argv) {
                "each reader says it matched this writer too");
   CLI11_PARSE(app, argc, argv);
 
-  rsg::load_profiles(rsg::default_profiles_dir());
-  rsg::Participant participant(domain, "rsg_participant");
+  rsg::dds::load_profiles(rsg::dds::default_profiles_dir());
+  rsg::dds::Participant participant(domain, "rsg_participant");
   fdds::Publisher& publisher = *participant.publisher(partitions);
   fdds::DataWriterQos qos = publisher.get_default_datawriter_qos();
   qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
@@ -69,13 +69,13 @@ int main(int argc, char** argv) {
       std::chrono::duration<double>(1.0 / rate_hz));
   auto next = std::chrono::steady_clock::now();
   rsg::RobotState sample;
-  for (const rsg::StateValues& values : rsg::test::mixed_stream(count)) {
-    rsg::to_sample(values, sample);
+  for (const rsg::wire::StateValues& values : rsg::test::mixed_stream(count)) {
+    rsg::dds::to_sample(values, sample);
     if (!writer->write(&sample)) {
       std::cerr << "rsg_views_publish: write failed\n";
       return 1;
     }
-    out << rsg::to_canonical_json(values) << '\n';
+    out << rsg::wire::to_canonical_json(values) << '\n';
     std::this_thread::sleep_until(next += period);
   }
   out.close();

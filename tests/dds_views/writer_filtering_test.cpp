@@ -25,19 +25,20 @@
 #include "sent_data_recorder.hpp"
 
 namespace rsg {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 constexpr std::uint8_t kForces = 0b001100;  // groups 2 and 3: view_forces
 
 // A participant with the given sole transport, through Participant's "default QoS" profile.
-std::unique_ptr<Participant> participant_with(
+std::unique_ptr<dds::Participant> participant_with(
     std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface> transport, int domain) {
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   fdds::DomainParticipantQos qos = fdds::PARTICIPANT_QOS_DEFAULT;
   qos.transport().use_builtin_transports = false;
   qos.transport().user_transports.push_back(std::move(transport));
   factory->set_default_participant_qos(qos);
-  auto participant = std::make_unique<Participant>(domain, "");
+  auto participant = std::make_unique<dds::Participant>(domain, "");
   factory->set_default_participant_qos(fdds::PARTICIPANT_QOS_DEFAULT);
   return participant;
 }
@@ -55,7 +56,7 @@ Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qo
   eprosima::fastrtps::LibrarySettingsAttributes settings;
   settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
   eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
-  load_profiles(default_profiles_dir());
+  dds::load_profiles(dds::default_profiles_dir());
   const int domain = static_cast<int>(::getpid() % 200 + 10);
 
   auto sent = std::make_shared<test::SentSamples>();
@@ -67,14 +68,14 @@ Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qo
   // Reliable, so that nothing is lost in the burst; a repair resends a sequence number already
   // recorded, and samples filtered out are announced as GAPs, not sent as DATA.
   fdds::Subscriber& subscriber = *subscribing->subscriber();
-  fdds::DataReaderQos reader_qos = load_reader_qos(subscriber, kLoggerReaderProfile);
+  fdds::DataReaderQos reader_qos = dds::load_reader_qos(subscriber, dds::kLoggerReaderProfile);
   if (delivery == Delivery::kDataSharing) {
     reader_qos.data_sharing().automatic();
   } else {
     reader_qos.data_sharing().off();
   }
-  ViewReader reader(subscriber, *subscribing->robot_state_topic("robot_state"), group_view(kForces),
-                    reader_qos);
+  dds::ViewReader reader(subscriber, *subscribing->robot_state_topic("robot_state"), dds::group_view(kForces),
+                         reader_qos);
 
   fdds::DataWriterQos writer_qos = base_writer_qos;
   writer_qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
@@ -87,10 +88,10 @@ Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qo
   EXPECT_TRUE(test::wait_for_matched_readers(*writer, 1));
 
   Outcome outcome;
-  const std::vector<StateValues> stream = test::mixed_stream(4 * test::kAllGroupSubsets);
+  const std::vector<wire::StateValues> stream = test::mixed_stream(4 * test::kAllGroupSubsets);
   RobotState sample;
   for (std::size_t i = 0; i < stream.size(); ++i) {
-    to_sample(stream[i], sample);
+    dds::to_sample(stream[i], sample);
     EXPECT_TRUE(writer->write(&sample));
     if (stream[i].selection.covers_groups(kForces)) outcome.accepted.insert(static_cast<std::int64_t>(i + 1));
   }
@@ -140,8 +141,8 @@ TEST(WriterSideFiltering, AWriterWithFiniteLivelinessSendsEverything) {
 
 // The QoS the gateway really publishes with (xml_profiles/gateway.xml).
 TEST(WriterSideFiltering, TheGatewayWriterProfileKeepsRejectedSamplesOffTheWire) {
-  load_profiles(default_profiles_dir());
-  Participant any(static_cast<int>(::getpid() % 200 + 10), "");
+  dds::load_profiles(dds::default_profiles_dir());
+  dds::Participant any(static_cast<int>(::getpid() % 200 + 10), "");
   fdds::DataWriterQos gateway_qos;
   ASSERT_EQ(any.publisher()->get_datawriter_qos_from_profile("rsg_state_writer", gateway_qos),
             ReturnCode_t::RETCODE_OK);

@@ -14,30 +14,30 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::span<const std::uint8_t> bytes(data, size);
-  const rsg::DecodeResult result = rsg::decode(bytes);
-  rsg::StateValues stitched;
-  rsg::FrameCodec codec(rsg::StateValues::layout());
-  const rsg::DecodeResult stitched_result = codec.decode(bytes, stitched.storage());
+  const rsg::wire::DecodeResult result = rsg::wire::decode(bytes);
+  rsg::wire::StateValues stitched;
+  rsg::wire::FrameCodec codec(rsg::wire::StateValues::layout());
+  const rsg::wire::DecodeResult stitched_result = codec.decode(bytes, stitched.storage());
   FUZZ_REQUIRE(stitched_result.error().category() == result.error().category());
   if (!result) {
-    FUZZ_REQUIRE(result.error().category() != rsg::ErrorCategory::kNone);
+    FUZZ_REQUIRE(result.error().category() != rsg::wire::ErrorCategory::kNone);
     FUZZ_REQUIRE(!result.error().message().empty());
     return 0;
   }
 
-  rsg::StateValues values;
+  rsg::wire::StateValues values;
   values.assign(result.frame());
   stitched.packet_number = stitched_result.frame().packet_number();
   stitched.selection = stitched_result.frame().selection();
   FUZZ_REQUIRE(stitched == values);
-  std::array<std::uint8_t, rsg::kMaxFrameBytes> encoded{};
-  const rsg::EncodeResult reencoded = rsg::encode(values.packet_number, values.selection, values.storage(),
-                                                  rsg::StateValues::layout(), encoded);
+  std::array<std::uint8_t, rsg::wire::kMaxFrameBytes> encoded{};
+  const rsg::wire::EncodeResult reencoded = rsg::wire::encode(
+      values.packet_number, values.selection, values.storage(), rsg::wire::StateValues::layout(), encoded);
   FUZZ_REQUIRE(reencoded);
   FUZZ_REQUIRE(reencoded.size == bytes.size());
   FUZZ_REQUIRE(std::equal(bytes.begin(), bytes.end(), encoded.begin()));
 
-  rsg::Deframer deframer;
+  rsg::wire::Deframer deframer;
   std::size_t frames = 0;
   deframer.feed(bytes, [&](std::span<const std::uint8_t> frame) {
     FUZZ_REQUIRE(std::ranges::equal(frame, bytes));

@@ -27,17 +27,17 @@ struct Outcome {
 };
 
 void require_correct_frame(std::span<const std::uint8_t> frame) {
-  FUZZ_REQUIRE(frame.size() >= rsg::kMinFrameBytes && frame.size() <= rsg::kMaxFrameBytes);
+  FUZZ_REQUIRE(frame.size() >= rsg::wire::kMinFrameBytes && frame.size() <= rsg::wire::kMaxFrameBytes);
   const std::size_t length = static_cast<std::size_t>(frame[1] | frame[2] << 8);
-  FUZZ_REQUIRE(frame.size() == rsg::kMinFrameBytes + length);
-  const std::size_t covered = rsg::kHeaderBytes + length;
+  FUZZ_REQUIRE(frame.size() == rsg::wire::kMinFrameBytes + length);
+  const std::size_t covered = rsg::wire::kHeaderBytes + length;
   std::uint32_t trailer;
   std::memcpy(&trailer, frame.data() + covered, sizeof trailer);
   FUZZ_REQUIRE(trailer == ::crc32(0, frame.data(), static_cast<uInt>(covered)));
 }
 
 Outcome deframe(std::span<const std::uint8_t> stream, std::span<const std::uint8_t> chunk_sizes) {
-  auto deframer = std::make_unique<rsg::Deframer>();  // 4 KiB of buffer: keep it off the stack
+  auto deframer = std::make_unique<rsg::wire::Deframer>();  // 4 KiB of buffer: keep it off the stack
   Outcome outcome;
   std::size_t consumed = 0;  // stream bytes accounted for: frames handed out plus bytes skipped
   std::size_t frame_bytes = 0;
@@ -60,7 +60,7 @@ Outcome deframe(std::span<const std::uint8_t> stream, std::span<const std::uint8
   outcome.pending_bytes = deframer->pending_bytes();
   FUZZ_REQUIRE(deframer->frames() == outcome.frame_sizes.size());
   FUZZ_REQUIRE(frame_bytes + outcome.skipped_bytes + outcome.pending_bytes == stream.size());
-  FUZZ_REQUIRE(outcome.pending_bytes < rsg::kMaxFrameBytes);  // only a possible frame is held back
+  FUZZ_REQUIRE(outcome.pending_bytes < rsg::wire::kMaxFrameBytes);  // only a possible frame is held back
   return outcome;
 }
 

@@ -12,28 +12,28 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  rsg::StateValues parsed;
+  rsg::wire::StateValues parsed;
   std::string error;
-  if (!rsg::parse_canonical_json(text, parsed, error)) {
+  if (!rsg::wire::parse_canonical_json(text, parsed, error)) {
     FUZZ_REQUIRE(!error.empty());
     return 0;
   }
 
-  std::array<std::uint8_t, rsg::kMaxFrameBytes> frame{};
-  const rsg::EncodeResult encoded = rsg::encode(parsed.packet_number, parsed.selection, parsed.storage(),
-                                                rsg::StateValues::layout(), frame);
+  std::array<std::uint8_t, rsg::wire::kMaxFrameBytes> frame{};
+  const rsg::wire::EncodeResult encoded = rsg::wire::encode(
+      parsed.packet_number, parsed.selection, parsed.storage(), rsg::wire::StateValues::layout(), frame);
   if (!encoded) return 0;  // parsing takes e.g. robot_mode 7 or reserved bits, which no frame may carry
 
-  const rsg::DecodeResult decoded = rsg::decode(std::span(frame).first(encoded.size));
+  const rsg::wire::DecodeResult decoded = rsg::wire::decode(std::span(frame).first(encoded.size));
   FUZZ_REQUIRE(decoded);
-  rsg::StateValues values;
+  rsg::wire::StateValues values;
   values.assign(decoded.frame());
   FUZZ_REQUIRE(values == parsed);  // NaN from JSON is the canonical quiet NaN, so bits match too
 
-  const std::string canonical = rsg::to_canonical_json(values);
-  rsg::StateValues reparsed;
-  FUZZ_REQUIRE(rsg::parse_canonical_json(canonical, reparsed, error));
+  const std::string canonical = rsg::wire::to_canonical_json(values);
+  rsg::wire::StateValues reparsed;
+  FUZZ_REQUIRE(rsg::wire::parse_canonical_json(canonical, reparsed, error));
   FUZZ_REQUIRE(reparsed == values);
-  FUZZ_REQUIRE(rsg::to_canonical_json(reparsed) == canonical);
+  FUZZ_REQUIRE(rsg::wire::to_canonical_json(reparsed) == canonical);
   return 0;
 }

@@ -15,37 +15,37 @@
 namespace {
 
 void check_decoding(std::span<const std::uint8_t> bytes) {
-  const rsg::SelectionRequestResult request = rsg::decode_selection_request(bytes);
+  const rsg::wire::SelectionRequestResult request = rsg::wire::decode_selection_request(bytes);
   if (!request) {
     FUZZ_REQUIRE(!request.error.message().empty());
     return;
   }
-  std::array<std::uint8_t, rsg::kSelectionRequestBytes> encoded{};
-  const rsg::EncodeResult reencoded =
-      rsg::encode_selection_request(request.packet_number, request.selection, encoded);
+  std::array<std::uint8_t, rsg::wire::kSelectionRequestBytes> encoded{};
+  const rsg::wire::EncodeResult reencoded =
+      rsg::wire::encode_selection_request(request.packet_number, request.selection, encoded);
   FUZZ_REQUIRE(reencoded && reencoded.size == bytes.size());
   FUZZ_REQUIRE(std::ranges::equal(bytes, encoded));
 
   // docs/protocol.md: a state decoder rejects a request (length_mismatch) unless it selects nothing.
-  const rsg::DecodeResult state = rsg::decode(bytes);
+  const rsg::wire::DecodeResult state = rsg::wire::decode(bytes);
   if (request.selection.data_bytes() == 0)
     FUZZ_REQUIRE(state);
   else
-    FUZZ_REQUIRE(!state && state.error().category() == rsg::ErrorCategory::kLengthMismatch);
+    FUZZ_REQUIRE(!state && state.error().category() == rsg::wire::ErrorCategory::kLengthMismatch);
 }
 
 void check_encoding(std::span<const std::uint8_t> bytes) {
-  if (bytes.size() < 2 + rsg::kGroupCount) return;
-  rsg::Selection selection;
+  if (bytes.size() < 2 + rsg::wire::kGroupCount) return;
+  rsg::wire::Selection selection;
   selection.group_select = bytes[1];
-  std::memcpy(selection.data_select.data(), bytes.data() + 2, rsg::kGroupCount);
-  std::array<std::uint8_t, rsg::kSelectionRequestBytes> encoded{};
-  const rsg::EncodeResult result = rsg::encode_selection_request(bytes[0], selection, encoded);
+  std::memcpy(selection.data_select.data(), bytes.data() + 2, rsg::wire::kGroupCount);
+  std::array<std::uint8_t, rsg::wire::kSelectionRequestBytes> encoded{};
+  const rsg::wire::EncodeResult result = rsg::wire::encode_selection_request(bytes[0], selection, encoded);
   if (!result) {
     FUZZ_REQUIRE(result.size == 0 && !result.error.message().empty());
     return;
   }
-  const rsg::SelectionRequestResult request = rsg::decode_selection_request(encoded);
+  const rsg::wire::SelectionRequestResult request = rsg::wire::decode_selection_request(encoded);
   FUZZ_REQUIRE(request);
   FUZZ_REQUIRE(request.packet_number == bytes[0] && request.selection == selection);
 }

@@ -221,9 +221,9 @@ TEST(GatewayConfig, RequestedSelectionIsTheUnionOfGroupsAndFields) {
   GatewayConfig config;
   config.request_groups = {"2"};
   config.request_fields = {"time"};
-  Selection expected;
+  wire::Selection expected;
   expected.add_group(2);
-  expected.add(Field::time);
+  expected.add(wire::Field::time);
   EXPECT_EQ(requested_selection(config), expected);
 }
 

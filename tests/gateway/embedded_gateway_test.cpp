@@ -1,4 +1,4 @@
-// rsg::EmbeddedGateway: the callback gets exactly the samples a reader in another participant
+// rsg::gateway::EmbeddedGateway: the callback gets exactly the samples a reader in another participant
 // receives over the network (the same frames, byte for byte, in the same order), never a rejected
 // frame, and nothing after stop(); an unusable configuration throws before anything starts.
 #include "rsg/gateway/embedded_gateway.hpp"
@@ -20,6 +20,7 @@
 #include "rsg/dds/robot_state.hpp"
 
 namespace rsg {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 using namespace std::chrono_literals;
@@ -34,8 +35,8 @@ std::string config(int domain, const std::string& topic) {
 }
 
 Bytes frame_of(const RobotState& sample) {
-  Bytes frame(kMaxFrameBytes);
-  const EncodeResult encoded = to_frame(sample, frame);
+  Bytes frame(wire::kMaxFrameBytes);
+  const wire::EncodeResult encoded = dds::to_frame(sample, frame);
   EXPECT_TRUE(encoded);
   frame.resize(encoded.size);
   return frame;
@@ -55,12 +56,12 @@ class EmbeddedGatewayTest : public ::testing::Test {
 TEST_F(EmbeddedGatewayTest, CallbackSeesExactlyWhatARemoteReaderReceives) {
   std::mutex mutex;
   std::vector<Bytes> from_callback;
-  EmbeddedGateway gateway(config(domain_, "embedded_same"), [&](const RobotState& sample) {
+  gateway::EmbeddedGateway gateway(config(domain_, "embedded_same"), [&](const RobotState& sample) {
     const std::lock_guard lock(mutex);
     from_callback.push_back(frame_of(sample));
   });
 
-  Participant participant(domain_, "rsg_participant");
+  dds::Participant participant(domain_, "rsg_participant");
   fdds::DataReaderQos qos = fdds::DATAREADER_QOS_DEFAULT;
   qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
   qos.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
@@ -77,14 +78,15 @@ TEST_F(EmbeddedGatewayTest, CallbackSeesExactlyWhatARemoteReaderReceives) {
 
   std::mt19937_64 rng(3);
   std::vector<Bytes> sent;
-  const Endpoint to = gateway.local_endpoint();
-  UdpSocket robot = UdpSocket::for_sending_to(to);
+  const transport::Endpoint to = gateway.local_endpoint();
+  transport::UdpSocket robot = transport::UdpSocket::for_sending_to(to);
   for (std::size_t i = 0; i < kFrames; ++i) {
-    StateValues values = test::random_state(rng);
-    values.packet_number = static_cast<std::uint8_t>(i % kPacketNumberModulo);
-    Bytes frame(kMaxFrameBytes);
+    wire::StateValues values = test::random_state(rng);
+    values.packet_number = static_cast<std::uint8_t>(i % wire::kPacketNumberModulo);
+    Bytes frame(wire::kMaxFrameBytes);
     frame.resize(
-        encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), frame).size);
+        encode(values.packet_number, values.selection, values.storage(), wire::StateValues::layout(), frame)
+            .size);
     if (i % kCorruptEvery == kCorruptEvery - 1)
       frame.back() ^= 0xFF;  // rejected: neither the callback nor DDS may see it
     else
@@ -115,16 +117,16 @@ TEST_F(EmbeddedGatewayTest, CallbackSeesExactlyWhatARemoteReaderReceives) {
 
 TEST_F(EmbeddedGatewayTest, NoCallbackAfterStop) {
   std::atomic<int> calls{0};
-  EmbeddedGateway gateway(config(domain_, "embedded_stop"), [&](const RobotState&) { ++calls; });
-  const Endpoint to = gateway.local_endpoint();
+  gateway::EmbeddedGateway gateway(config(domain_, "embedded_stop"), [&](const RobotState&) { ++calls; });
+  const transport::Endpoint to = gateway.local_endpoint();
   gateway.stop();
   gateway.stop();  // idempotent
   EXPECT_THROW(gateway.local_endpoint(), std::logic_error);
-  StateValues values;
-  values.selection = Selection::all();
-  Bytes frame(kMaxFrameBytes);
-  frame.resize(encode(0, values.selection, values.storage(), StateValues::layout(), frame).size);
-  UdpSocket robot = UdpSocket::for_sending_to(to);
+  wire::StateValues values;
+  values.selection = wire::Selection::all();
+  Bytes frame(wire::kMaxFrameBytes);
+  frame.resize(encode(0, values.selection, values.storage(), wire::StateValues::layout(), frame).size);
+  transport::UdpSocket robot = transport::UdpSocket::for_sending_to(to);
   robot.send_to(frame, to);  // the port is closed: may be refused
   std::this_thread::sleep_for(50ms);
   EXPECT_EQ(calls.load(), 0);
@@ -133,7 +135,7 @@ TEST_F(EmbeddedGatewayTest, NoCallbackAfterStop) {
 TEST_F(EmbeddedGatewayTest, UnusableConfigurationThrowsNamingTheProblem) {
   const auto message_of = [](const std::string& yaml) {
     try {
-      EmbeddedGateway gateway(yaml, [](const RobotState&) {});
+      gateway::EmbeddedGateway gateway(yaml, [](const RobotState&) {});
     } catch (const std::invalid_argument& error) {
       return std::string(error.what());
     }

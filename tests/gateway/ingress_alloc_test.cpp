@@ -1,7 +1,7 @@
 // The gateway's own ingress loop allocates nothing in steady state: the real Ingress (UDP socket,
 // source filter, batch receive, decode, sequence tracker, link monitor, loaned write) over 10,000
 // frames after 1,000 of warm-up, counting every operator new made on this thread. The ingress
-// has an `on_sample` callback, as rsg::EmbeddedGateway gives it, so the embedded path from
+// has an `on_sample` callback, as rsg::gateway::EmbeddedGateway gives it, so the embedded path from
 // datagram to callback is counted too.
 // tests/unit/hot_path_alloc_test.cpp covers decode + write alone.
 //
@@ -37,6 +37,7 @@
 #include "rsg/wire/frame.hpp"
 
 namespace rsg::gateway {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 using namespace std::chrono_literals;
@@ -73,13 +74,14 @@ std::vector<std::vector<std::uint8_t>> make_frames(std::size_t count) {
   std::mt19937_64 rng(7);
   std::vector<std::vector<std::uint8_t>> frames;
   for (std::size_t i = 0; i < count; ++i) {
-    StateValues values = test::random_state(rng);
-    values.selection = Selection::all();
-    values.packet_number = static_cast<std::uint8_t>(i % kPacketNumberModulo);
-    values.set_integer(Field::time, i);
-    std::vector<std::uint8_t> frame(kMaxFrameBytes);
+    wire::StateValues values = test::random_state(rng);
+    values.selection = wire::Selection::all();
+    values.packet_number = static_cast<std::uint8_t>(i % wire::kPacketNumberModulo);
+    values.set_integer(wire::Field::time, i);
+    std::vector<std::uint8_t> frame(wire::kMaxFrameBytes);
     frame.resize(
-        encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), frame).size);
+        encode(values.packet_number, values.selection, values.storage(), wire::StateValues::layout(), frame)
+            .size);
     if (i % kCorruptEvery == kCorruptEvery - 1) frame.back() ^= 0xFF;
     frames.push_back(std::move(frame));
   }
@@ -93,9 +95,9 @@ class IngressAllocation : public ::testing::Test {
     eprosima::fastrtps::LibrarySettingsAttributes settings;
     settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
     eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
-    load_profiles(std::filesystem::path(RSG_PROFILES_DIR) / "gateway.xml");
+    dds::load_profiles(std::filesystem::path(RSG_PROFILES_DIR) / "gateway.xml");
     // UDP only: Fast DDS 2.9's SHM transport allocates per send, which would hide rsg's own.
-    load_profiles(std::filesystem::path(RSG_TEST_DATA_DIR) / "hot_path_profiles.xml");
+    dds::load_profiles(std::filesystem::path(RSG_TEST_DATA_DIR) / "hot_path_profiles.xml");
     ASSERT_EQ(eprosima::fastrtps::xmlparser::XMLProfileManager::loadXMLString(kBestEffortProfile.data(),
                                                                               kBestEffortProfile.size()),
               eprosima::fastrtps::xmlparser::XMLP_ret::XML_OK);
@@ -103,7 +105,7 @@ class IngressAllocation : public ::testing::Test {
 
   Ingress::Options options(const std::string& writer_profile) {
     Ingress::Options options;
-    options.listen = Endpoint::parse("127.0.0.1:0");
+    options.listen = transport::Endpoint::parse("127.0.0.1:0");
     options.receive_buffer = 4 << 20;
     std::string error;
     EXPECT_TRUE(options.sources.allow("127.0.0.0/8", error)) << error;  // a filter that is consulted
@@ -150,9 +152,9 @@ class IngressAllocation : public ::testing::Test {
     for (int i = 0; i < 500 && stats().state_readers == 0; ++i) std::this_thread::sleep_for(10ms);
     EXPECT_EQ(stats().state_readers, 1U) << "the reader never matched";
 
-    UdpSocket robot = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
-    const Endpoint gateway = ingress.local_endpoint();
-    const std::array<std::uint8_t, kMaxFrameBytes + 100> oversize{};
+    transport::UdpSocket robot = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
+    const transport::Endpoint gateway = ingress.local_endpoint();
+    const std::array<std::uint8_t, wire::kMaxFrameBytes + 100> oversize{};
     const auto frames = make_frames(kWarmUp + kMeasured);
     std::mt19937 burst_sizes(11);
     std::size_t received = 0;
@@ -183,8 +185,8 @@ class IngressAllocation : public ::testing::Test {
     const GatewayStats final_stats = stats();
     EXPECT_EQ(final_stats.ingress.received, received);
     const std::uint64_t corrupted = frames.size() / kCorruptEvery;
-    EXPECT_EQ(final_stats.ingress.invalid[invalid_index(ErrorCategory::kBadCrc)], corrupted);
-    EXPECT_EQ(final_stats.ingress.invalid[invalid_index(ErrorCategory::kLengthMismatch)],
+    EXPECT_EQ(final_stats.ingress.invalid[invalid_index(wire::ErrorCategory::kBadCrc)], corrupted);
+    EXPECT_EQ(final_stats.ingress.invalid[invalid_index(wire::ErrorCategory::kLengthMismatch)],
               received - frames.size());
     EXPECT_EQ(final_stats.ingress.published, frames.size() - corrupted);
     EXPECT_EQ(callbacks_, frames.size() - corrupted) << "the callback must see every valid frame, only those";
@@ -217,8 +219,8 @@ class IngressAllocation : public ::testing::Test {
   std::string type_name_;  // empty: rsg's own
   std::vector<Ingress::Options::RateTopic> rate_topics_;
   const int domain_ = static_cast<int>(::getpid() % 200 + 10);
-  Participant publishing_{domain_, "rsg_hot_path_udp"};
-  Participant subscribing_{domain_, "rsg_hot_path_udp"};
+  dds::Participant publishing_{domain_, "rsg_hot_path_udp"};
+  dds::Participant subscribing_{domain_, "rsg_hot_path_udp"};
 };
 
 TEST_F(IngressAllocation, WithTheGatewayProfileOnlyFastDdsReliableWriterAllocates) {
@@ -252,12 +254,12 @@ TEST_F(IngressAllocation, WithTheFlightRecorderOnNothingAllocates) {
            ASSERT_TRUE(dumped.has_value());
            EXPECT_EQ(dumped->frames, 2401U);
            capture::PcapReader reader(dumped->path.string());
-           const Endpoint listen = ingress.local_endpoint();
+           const transport::Endpoint listen = ingress.local_endpoint();
            std::size_t index = sent.size() - dumped->frames;
            while (const auto packet = reader.next()) {
              ASSERT_LT(index, sent.size());
              const std::span<const std::uint8_t> datagram = sent[index++];
-             const auto kept = datagram.first(std::min(datagram.size(), kMaxFrameBytes));
+             const auto kept = datagram.first(std::min(datagram.size(), wire::kMaxFrameBytes));
              EXPECT_TRUE(std::ranges::equal(packet->payload, kept)) << "datagram " << index - 1;
              EXPECT_EQ(packet->to.port, listen.port());
            }
@@ -310,10 +312,10 @@ TEST_F(IngressAllocation, WithTheRos2StandardTopicsOnNothingAllocates) {
 // the ingress loop are the same, so ROS 2 mode allocates nothing either, nor do rate topics (one
 // by robot time, one every 10th frame), whose writes copy into their writers' preallocated history.
 TEST_F(IngressAllocation, InRos2ModeWithRateTopicsNothingAllocates) {
-  topic_ = ros2_topic_name("/robot1", "robot_state");
-  type_name_ = std::string(kRos2RobotStateType);
-  rate_topics_ = {{ros2_topic_name("/robot1", "robot_state_100hz"), {0, 10ms}},
-                  {ros2_topic_name("/robot1", "robot_state_tenth"), {10, {}}}};
+  topic_ = dds::ros2_topic_name("/robot1", "robot_state");
+  type_name_ = std::string(dds::kRos2RobotStateType);
+  rate_topics_ = {{dds::ros2_topic_name("/robot1", "robot_state_100hz"), {0, 10ms}},
+                  {dds::ros2_topic_name("/robot1", "robot_state_tenth"), {10, {}}}};
   stream("ingress_alloc_best_effort", fdds::BEST_EFFORT_RELIABILITY_QOS);
   expect_none_by_rsg();
   EXPECT_EQ(allocations_.by_fast_dds(), 0U) << "Fast DDS allocated on the ingress thread";

@@ -70,8 +70,8 @@ TEST(LogThrottle, AllowsOneLinePerInterval) {
   EXPECT_FALSE(throttle.allow(kStart + milliseconds(1500)));
 }
 
-Selection groups(std::initializer_list<std::size_t> list) {
-  Selection selection;
+wire::Selection groups(std::initializer_list<std::size_t> list) {
+  wire::Selection selection;
   for (const std::size_t group : list) selection.add_group(group);
   return selection;
 }

@@ -8,7 +8,7 @@ namespace rsg::gateway {
 namespace {
 
 bool allows(const SourceFilter& filter, const char* host_port) {
-  return filter.allows(Endpoint::parse(host_port).address());
+  return filter.allows(transport::Endpoint::parse(host_port).address());
 }
 
 SourceFilter filter_of(std::initializer_list<const char*> networks) {

@@ -30,14 +30,14 @@ TEST(StatusSample, EveryCategoryLandsInTheMemberOfItsName) {
   GatewayStatus sample;
   to_status_sample(distinct_stats(), sample);
   const InvalidFrameCounts& invalid = sample.invalid();
-  const auto at = [](ErrorCategory category) { return 100 + invalid_index(category); };
-  EXPECT_EQ(invalid.truncated(), at(ErrorCategory::kTruncated));
-  EXPECT_EQ(invalid.length_mismatch(), at(ErrorCategory::kLengthMismatch));
-  EXPECT_EQ(invalid.bad_crc(), at(ErrorCategory::kBadCrc));
-  EXPECT_EQ(invalid.bad_request(), at(ErrorCategory::kBadRequest));
-  EXPECT_EQ(invalid.reserved_bits(), at(ErrorCategory::kReservedBits));
-  EXPECT_EQ(invalid.selection_mismatch(), at(ErrorCategory::kSelectionMismatch));
-  EXPECT_EQ(invalid.bad_value(), at(ErrorCategory::kBadValue));
+  const auto at = [](wire::ErrorCategory category) { return 100 + invalid_index(category); };
+  EXPECT_EQ(invalid.truncated(), at(wire::ErrorCategory::kTruncated));
+  EXPECT_EQ(invalid.length_mismatch(), at(wire::ErrorCategory::kLengthMismatch));
+  EXPECT_EQ(invalid.bad_crc(), at(wire::ErrorCategory::kBadCrc));
+  EXPECT_EQ(invalid.bad_request(), at(wire::ErrorCategory::kBadRequest));
+  EXPECT_EQ(invalid.reserved_bits(), at(wire::ErrorCategory::kReservedBits));
+  EXPECT_EQ(invalid.selection_mismatch(), at(wire::ErrorCategory::kSelectionMismatch));
+  EXPECT_EQ(invalid.bad_value(), at(wire::ErrorCategory::kBadValue));
 }
 
 TEST(StatusSample, CountersAndLinkStateAreCopied) {
@@ -84,15 +84,15 @@ TEST(StatsJson, UsesTheStatusNamesAndCategoryNames) {
   EXPECT_EQ(json["robot_restarts"], 8);
   EXPECT_EQ(json["invalid"]["truncated"], 100);
   EXPECT_EQ(json["invalid"]["bad_value"], 106);
-  EXPECT_EQ(json["invalid"].size(), kErrorCategoryCount);
+  EXPECT_EQ(json["invalid"].size(), wire::kErrorCategoryCount);
   EXPECT_EQ(json["source"], "192.0.2.1:40000");
   EXPECT_EQ(json["standard_dropped"], 15);
 }
 
 TEST(StatsSummary, NamesOnlyTheCategoriesThatOccurred) {
   InvalidCounts counts{};
-  counts[invalid_index(ErrorCategory::kBadCrc)] = 3;
-  counts[invalid_index(ErrorCategory::kTruncated)] = 1;
+  counts[invalid_index(wire::ErrorCategory::kBadCrc)] = 3;
+  counts[invalid_index(wire::ErrorCategory::kTruncated)] = 1;
   EXPECT_EQ(format_invalid(counts), "truncated=1 bad_crc=3");
   EXPECT_NE(summary_line(distinct_stats()).find("link up"), std::string::npos);
   EXPECT_NE(summary_line(distinct_stats()).find("; standard_dropped 15"), std::string::npos);

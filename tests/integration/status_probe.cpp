@@ -26,8 +26,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   namespace fdds = eprosima::fastdds::dds;
-  rsg::load_profiles(rsg::default_profiles_dir());
-  rsg::Participant participant(domain, "rsg_participant");
+  rsg::dds::load_profiles(rsg::dds::default_profiles_dir());
+  rsg::dds::Participant participant(domain, "rsg_participant");
   fdds::Topic* topic = participant.topic(topic_name, fdds::TypeSupport(new rsg::GatewayStatusPubSubType()));
   fdds::Subscriber* subscriber = participant.subscriber(
       partition.empty() ? std::vector<std::string>{} : std::vector<std::string>{partition});

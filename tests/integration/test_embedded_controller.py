@@ -1,5 +1,5 @@
 """examples/embedded_controller: the gateway inside a controller process. rsg_sim -> the example's
-rsg::EmbeddedGateway -> its callback gets every frame, and rsg_echo in another process still
+rsg::gateway::EmbeddedGateway -> its callback gets every frame, and rsg_echo in another process still
 receives every sample over DDS, with the values the sim sent."""
 
 import re

@@ -40,11 +40,11 @@ int main(int argc, char** argv) {
     Entity waitset(dds_create_waitset(participant.get()), "waitset");
     dds_waitset_attach(waitset.get(), reader.get(), 0);
 
-    rsg::StateValues values;
+    rsg::wire::StateValues values;
     const bool complete = rsg::interop::print_samples<rsg_RobotState>(
         reader.get(), waitset.get(), count, timeout, "rsg_cyclone_echo", [&](const rsg_RobotState& sample) {
           rsg::interop::to_values(sample, values);
-          return rsg::to_canonical_json(values);
+          return rsg::wire::to_canonical_json(values);
         });
     if (!complete) return 1;
     return 0;

@@ -53,11 +53,11 @@ int main(int argc, char** argv) {
       return 1;
     }
 
-    rsg::StateValues values;
+    rsg::wire::StateValues values;
     rsg_RobotState sample;
     std::string line, error;
     while (std::getline(input, line)) {
-      if (!rsg::parse_canonical_json(line, values, error)) {
+      if (!rsg::wire::parse_canonical_json(line, values, error)) {
         std::cerr << "rsg_cyclone_publish: " << error << '\n';
         return 2;
       }

@@ -19,12 +19,12 @@ namespace rsg::interop {
 
 /// Offsets of the fields inside idlc's C struct. A member whose C shape differs from the field
 /// table fails to compile here.
-inline const FieldLayout& cyclone_layout() {
-  static const FieldLayout layout = [] {
-    FieldLayout result;
-#define RSG_LOCATE_C_MEMBER(name, index, group, mask, type, count, bytes)     \
-  static_assert(sizeof(rsg_RobotState::name) == kFields[index].value_bytes(), \
-                "C member " #name " does not match the field table");         \
+inline const wire::FieldLayout& cyclone_layout() {
+  static const wire::FieldLayout layout = [] {
+    wire::FieldLayout result;
+#define RSG_LOCATE_C_MEMBER(name, index, group, mask, type, count, bytes)           \
+  static_assert(sizeof(rsg_RobotState::name) == wire::kFields[index].value_bytes(), \
+                "C member " #name " does not match the field table");               \
   result.offsets[index] = static_cast<std::uint32_t>(offsetof(rsg_RobotState, name));
     RSG_FIELDS(RSG_LOCATE_C_MEMBER)
 #undef RSG_LOCATE_C_MEMBER
@@ -36,35 +36,35 @@ inline const FieldLayout& cyclone_layout() {
 /// Any idlc C struct with RobotState's members (e.g. the ROS 2 type built from rsg_msgs), given
 /// where its fields are.
 template <class Sample>
-void to_values(const Sample& sample, const FieldLayout& layout, StateValues& values) {
-  values = StateValues();
+void to_values(const Sample& sample, const wire::FieldLayout& layout, wire::StateValues& values) {
+  values = wire::StateValues();
   values.packet_number = sample.packet_number;
   values.selection.group_select = sample.group_select;
-  std::memcpy(values.selection.data_select.data(), sample.data_select, kGroupCount);
-  for (const FieldInfo& field : kFields)
-    std::memcpy(StateValues::layout().locate(values.storage(), field.id()),
+  std::memcpy(values.selection.data_select.data(), sample.data_select, wire::kGroupCount);
+  for (const wire::FieldInfo& field : wire::kFields)
+    std::memcpy(wire::StateValues::layout().locate(values.storage(), field.id()),
                 layout.locate(&sample, field.id()), field.value_bytes());
 }
 
-inline void to_values(const rsg_RobotState& sample, StateValues& values) {
+inline void to_values(const rsg_RobotState& sample, wire::StateValues& values) {
   to_values(sample, cyclone_layout(), values);
 }
 
 /// The other way round, for any such struct.
 template <class Sample>
-void to_sample(const StateValues& values, const FieldLayout& layout, Sample& sample) {
+void to_sample(const wire::StateValues& values, const wire::FieldLayout& layout, Sample& sample) {
   sample = Sample{};
   sample.packet_number = values.packet_number;
   sample.group_select = values.selection.group_select;
-  std::memcpy(sample.data_select, values.selection.data_select.data(), kGroupCount);
-  for (std::size_t group = 0; group < kGroupCount; ++group)
+  std::memcpy(sample.data_select, values.selection.data_select.data(), wire::kGroupCount);
+  for (std::size_t group = 0; group < wire::kGroupCount; ++group)
     sample.group_present[group] = values.selection.has_group(group);
-  for (const FieldInfo& field : kFields)
+  for (const wire::FieldInfo& field : wire::kFields)
     std::memcpy(layout.locate(&sample, field.id()),
-                StateValues::layout().locate(values.storage(), field.id()), field.value_bytes());
+                wire::StateValues::layout().locate(values.storage(), field.id()), field.value_bytes());
 }
 
-inline void to_sample(const StateValues& values, rsg_RobotState& sample) {
+inline void to_sample(const wire::StateValues& values, rsg_RobotState& sample) {
   to_sample(values, cyclone_layout(), sample);
 }
 

@@ -12,7 +12,7 @@
 #include "rsg/dds/robot_state.hpp"
 #include "vectors.hpp"
 
-namespace rsg::record {
+namespace rsg::tools::record {
 namespace {
 
 std::string read_text(const std::string& path) {
@@ -37,10 +37,10 @@ TEST(RecordingProfile, NamesAreParsed) {
 TEST(RecordingCdr, EveryVectorRoundTripsToTheSameFrame) {
   CdrSerializer serializer;
   for (const auto& vector : test::valid_vectors()) {
-    const DecodeResult decoded = decode(vector.frame);
+    const wire::DecodeResult decoded = wire::decode(vector.frame);
     ASSERT_TRUE(decoded);
     RobotState sample;
-    to_sample(decoded.frame(), sample);
+    dds::to_sample(decoded.frame(), sample);
     const auto payload = serializer.serialize(sample);
     ASSERT_GE(payload.size(), 4u);
     EXPECT_EQ(payload[0], 0x00);  // encapsulation CDR_LE, as Fast DDS sends it
@@ -48,8 +48,8 @@ TEST(RecordingCdr, EveryVectorRoundTripsToTheSameFrame) {
     const std::vector<std::uint8_t> bytes(payload.begin(), payload.end());
     RobotState back;
     ASSERT_TRUE(serializer.deserialize(bytes, back));
-    std::array<std::uint8_t, kMaxFrameBytes> out{};
-    const EncodeResult encoded = to_frame(back, out);
+    std::array<std::uint8_t, wire::kMaxFrameBytes> out{};
+    const wire::EncodeResult encoded = dds::to_frame(back, out);
     ASSERT_TRUE(encoded);
     EXPECT_EQ(std::vector<std::uint8_t>(out.begin(), out.begin() + static_cast<long>(encoded.size)),
               vector.frame);
@@ -68,4 +68,4 @@ TEST(RecordingCdr, ShortOrForeignPayloadsAreRefused) {
 }
 
 }  // namespace
-}  // namespace rsg::record
+}  // namespace rsg::tools::record

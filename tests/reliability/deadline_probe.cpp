@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
   int domain = 0;
   std::string state_topic = "robot_state";
   std::string status_topic = "rsg_gateway_status";
-  std::string qos_profile = rsg::kRealtimeReaderProfile;
+  std::string qos_profile = rsg::dds::kRealtimeReaderProfile;
   double timeout_s = 30;
   CLI::App app("Prints RobotState arrivals, deadline misses and GatewayStatus as timestamped JSON lines",
                "rsg_deadline_probe");
@@ -139,8 +139,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   std::signal(SIGTERM, [](int) { g_stop = 1; });
 
-  rsg::load_profiles(rsg::default_profiles_dir());
-  rsg::Participant participant(domain, "rsg_participant");
+  rsg::dds::load_profiles(rsg::dds::default_profiles_dir());
+  rsg::dds::Participant participant(domain, "rsg_participant");
   fdds::Subscriber* subscriber = participant.subscriber();
   EventLog log;
   StateListener state_listener(log);
@@ -148,8 +148,8 @@ int main(int argc, char** argv) {
 
   fdds::Topic* states = participant.robot_state_topic(state_topic);
   const ReaderGuard state_reader{
-      subscriber,
-      subscriber->create_datareader(states, rsg::load_reader_qos(*subscriber, qos_profile), &state_listener)};
+      subscriber, subscriber->create_datareader(states, rsg::dds::load_reader_qos(*subscriber, qos_profile),
+                                                &state_listener)};
   fdds::Topic* statuses =
       participant.topic(status_topic, fdds::TypeSupport(new rsg::GatewayStatusPubSubType()));
   const ReaderGuard status_reader{subscriber, subscriber->create_datareader_with_profile(

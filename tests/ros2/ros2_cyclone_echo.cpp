@@ -46,7 +46,7 @@ int publish(dds_domainid_t domain, const std::string& topic_name, const char* fi
     std::cerr << "rsg_ros2_cyclone_echo: cannot open " << file << '\n';
     return 2;
   }
-  const rsg::FieldLayout layout = rsg::ros2_test::ros2_layout();
+  const rsg::wire::FieldLayout layout = rsg::ros2_test::ros2_layout();
   Entity participant(dds_create_participant(domain, nullptr, nullptr), "participant");
   Entity topic(dds_create_topic(participant.get(), &rsg_msgs_msg_dds__RobotState__desc, topic_name.c_str(),
                                 nullptr, nullptr),
@@ -66,11 +66,11 @@ int publish(dds_domainid_t domain, const std::string& topic_name, const char* fi
     std::cerr << "rsg_ros2_cyclone_echo: no reader on " << topic_name << '\n';
     return 1;
   }
-  rsg::StateValues values;
+  rsg::wire::StateValues values;
   rsg_msgs_msg_dds__RobotState_ sample;
   std::string line, error;
   while (std::getline(input, line)) {
-    if (!rsg::parse_canonical_json(line, values, error)) {
+    if (!rsg::wire::parse_canonical_json(line, values, error)) {
       std::cerr << "rsg_ros2_cyclone_echo: " << error << '\n';
       return 2;
     }
@@ -110,7 +110,7 @@ int main(int argc, char** argv) {
   const unsigned long count = std::stoul(argv[5]);
   const dds_duration_t timeout = DDS_SECS(std::stol(argv[6]));
   try {
-    const rsg::FieldLayout layout = rsg::ros2_test::ros2_layout();
+    const rsg::wire::FieldLayout layout = rsg::ros2_test::ros2_layout();
     const dds_topic_descriptor_t* type =
         state ? &rsg_msgs_msg_dds__RobotState__desc : &rsg_msgs_msg_dds__GatewayStatus__desc;
     Qos reader_qos;
@@ -124,13 +124,13 @@ int main(int argc, char** argv) {
     rsg::ros2_test::VolatileReader subscription(domain, type, topic_name, reader_qos);
     if (!subscription.wait_for_writer(timeout, "rsg_ros2_cyclone_echo")) return 1;
 
-    rsg::StateValues values;
+    rsg::wire::StateValues values;
     const bool complete =
         state ? rsg::interop::print_samples<rsg_msgs_msg_dds__RobotState_>(
                     subscription.reader(), subscription.waitset(), count, timeout, "rsg_ros2_cyclone_echo",
                     [&](const rsg_msgs_msg_dds__RobotState_& sample) {
                       rsg::interop::to_values(sample, layout, values);
-                      return rsg::to_canonical_json(values);
+                      return rsg::wire::to_canonical_json(values);
                     })
               : rsg::interop::print_samples<rsg_msgs_msg_dds__GatewayStatus_>(
                     subscription.reader(), subscription.waitset(), count, timeout, "rsg_ros2_cyclone_echo",

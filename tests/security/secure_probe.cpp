@@ -55,6 +55,7 @@
 #include "rsg/wire/json.hpp"
 
 namespace rsg::security_probe {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 namespace rtps = eprosima::fastrtps::rtps;
@@ -83,15 +84,15 @@ std::vector<std::string> partitions(const Options& options) {
 
 /// The samples both ends agree on. With `marker`, every field is selected and every double is
 /// kMarker, so that each sample carries the pattern many times over.
-std::vector<StateValues> make_samples(const Options& options) {
-  std::vector<StateValues> samples;
+std::vector<wire::StateValues> make_samples(const Options& options) {
+  std::vector<wire::StateValues> samples;
   std::mt19937_64 rng(options.seed);
   for (std::size_t i = 0; i < options.samples; ++i) {
-    StateValues values = test::random_state(rng);
+    wire::StateValues values = test::random_state(rng);
     if (options.marker) {
-      values.selection = Selection::all();
-      for (const FieldInfo& field : kFields)
-        if (field.type == ElementType::kFloat64)
+      values.selection = wire::Selection::all();
+      for (const wire::FieldInfo& field : wire::kFields)
+        if (field.type == wire::ElementType::kFloat64)
           for (double& element : values.doubles(field.id())) element = kMarker;
     }
     samples.push_back(values);
@@ -101,7 +102,9 @@ std::vector<StateValues> make_samples(const Options& options) {
 
 /// The marker as CDR puts it on the wire: Fast DDS serializes in the host's byte order, so in the
 /// order it has in memory.
-std::string marker_hex() { return to_hex(std::bit_cast<std::array<std::uint8_t, sizeof kMarker>>(kMarker)); }
+std::string marker_hex() {
+  return wire::to_hex(std::bit_cast<std::array<std::uint8_t, sizeof kMarker>>(kMarker));
+}
 
 std::string to_string(const rtps::GuidPrefix_t& prefix) {
   std::ostringstream text;
@@ -188,7 +191,8 @@ class WriterEvents : public fdds::DataWriterListener {
 /// same seed, in order: reliable transient-local delivery loses and reorders nothing.
 class ReaderEvents : public fdds::DataReaderListener {
  public:
-  ReaderEvents(EventLog& log, const std::vector<StateValues>& expected) : log_(log), expected_(expected) {}
+  ReaderEvents(EventLog& log, const std::vector<wire::StateValues>& expected)
+      : log_(log), expected_(expected) {}
 
   void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& status) override {
     emit_match(log_, status.current_count_change, status.last_publication_handle);
@@ -198,11 +202,11 @@ class ReaderEvents : public fdds::DataReaderListener {
     fdds::SampleInfo info;
     while (reader->take_next_sample(&sample_, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
-      StateValues received;
-      to_values(sample_, received);
+      wire::StateValues received;
+      dds::to_values(sample_, received);
       const bool exact = next_index_ < expected_.size() && received == expected_[next_index_];
       nlohmann::ordered_json event = {{"event", "sample"}, {"index", next_index_}, {"exact", exact}};
-      if (!exact) event["received"] = nlohmann::json::parse(to_canonical_json(received));
+      if (!exact) event["received"] = nlohmann::json::parse(wire::to_canonical_json(received));
       log_.emit(event);
       ++next_index_;
     }
@@ -210,7 +214,7 @@ class ReaderEvents : public fdds::DataReaderListener {
 
  private:
   EventLog& log_;
-  const std::vector<StateValues>& expected_;
+  const std::vector<wire::StateValues>& expected_;
   std::size_t next_index_ = 0;
   RobotState sample_;  // reused: a RobotState is a few kilobytes
 };
@@ -247,7 +251,7 @@ fdds::DataReaderQos reader_qos(fdds::Subscriber& subscriber) {
 
 /// Enables a participant created disabled (see run), once the listener is in place: discovery and
 /// authentication start on enable, so no event is missed.
-void enable_with_listener(Participant& participant, ParticipantEvents& listener) {
+void enable_with_listener(dds::Participant& participant, ParticipantEvents& listener) {
   // No status callbacks: with data_on_readers in its mask, a participant listener takes the data
   // that the readers' own listeners are waiting for. Discovery and authentication are unmasked.
   participant.get()->set_listener(&listener, fdds::StatusMask::none());
@@ -262,7 +266,7 @@ void wait_for_stdin_to_close() {
 }
 
 void run(const Options& options, bool publishing) {
-  for (const auto& file : options.profile_files) load_profiles(file);
+  for (const auto& file : options.profile_files) dds::load_profiles(file);
   // Participants start disabled; enable_with_listener enables ours.
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   fdds::DomainParticipantFactoryQos factory_qos;
@@ -271,13 +275,13 @@ void run(const Options& options, bool publishing) {
   factory->set_qos(factory_qos);
 
   // Listeners first: they must outlive the participant, whose threads call them until it is gone.
-  const std::vector<StateValues> samples = make_samples(options);
+  const std::vector<wire::StateValues> samples = make_samples(options);
   EventLog log;
   ParticipantEvents participant_events(log);
   WriterEvents writer_events(log);
   ReaderEvents reader_events(log, samples);
 
-  Participant participant(options.domain, options.profile);
+  dds::Participant participant(options.domain, options.profile);
   enable_with_listener(participant, participant_events);
   fdds::Topic* topic = participant.robot_state_topic(options.topic);
 
@@ -290,8 +294,8 @@ void run(const Options& options, bool publishing) {
       endpoint_created = true;
       if (options.wait_for_reader) wait_for_a_reader(*writer);
       RobotState sample;
-      for (const StateValues& values : samples) {
-        to_sample(values, sample);
+      for (const wire::StateValues& values : samples) {
+        dds::to_sample(values, sample);
         if (!writer->write(&sample)) throw std::runtime_error("cannot write a sample");
       }
     }

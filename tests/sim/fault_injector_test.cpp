@@ -9,42 +9,42 @@
 #include "panda_model.hpp"
 #include "schedule.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 namespace {
 
 // Selections that exercise the edge cases: everything, one field, an empty frame, no group 5,
 // group 5 only, error sets already present.
-std::vector<Selection> selections() {
-  std::vector<Selection> result;
+std::vector<wire::Selection> selections() {
+  std::vector<wire::Selection> result;
   for (const char* items :
        {"all", "q", "g0", "g5", "g3,g4", "current_errors,last_motion_errors", "O_T_EE,time"}) {
-    Selection selection;
+    wire::Selection selection;
     std::string error;
     EXPECT_TRUE(parse_selection_items(items, selection, error)) << error;
     result.push_back(selection);
   }
-  result.push_back(Selection{});
+  result.push_back(wire::Selection{});
   return result;
 }
 
-class CraftInvalid : public ::testing::TestWithParam<ErrorCategory> {};
+class CraftInvalid : public ::testing::TestWithParam<wire::ErrorCategory> {};
 
 TEST_P(CraftInvalid, DecoderReportsExactlyThatCategory) {
-  const ErrorCategory category = GetParam();
+  const wire::ErrorCategory category = GetParam();
   const PandaModel model(1);
   std::mt19937_64 random(99);
   std::array<std::uint8_t, kCraftedDatagramBytes> out{};
-  for (const Selection& selection : selections()) {
-    StateValues values;
+  for (const wire::Selection& selection : selections()) {
+    wire::StateValues values;
     values.selection = selection;
-    for (std::uint8_t packet_number = 0; packet_number < kPacketNumberModulo; ++packet_number) {
+    for (std::uint8_t packet_number = 0; packet_number < wire::kPacketNumberModulo; ++packet_number) {
       values.packet_number = packet_number;
-      model.fill(std::chrono::milliseconds(packet_number * 31), Selection::all(), values);
+      model.fill(std::chrono::milliseconds(packet_number * 31), wire::Selection::all(), values);
       // Many draws per case: each category has several ways of breaking a frame.
       for (int draw = 0; draw < 20; ++draw) {
         const std::size_t size = craft_invalid(category, values, random, out);
         ASSERT_LE(size, out.size());
-        const DecodeResult decoded = decode(std::span(out).first(size));
+        const wire::DecodeResult decoded = wire::decode(std::span(out).first(size));
         ASSERT_FALSE(decoded) << to_string(category);
         ASSERT_EQ(decoded.error().category(), category)
             << "aimed at " << to_string(category) << ", got: " << decoded.error().message();
@@ -85,12 +85,12 @@ TEST(FaultPlan, ProbabilitiesGiveRoughlyTheirShare) {
 
 TEST(FaultPlan, CorruptionsCycleThroughTheChosenCategories) {
   FaultConfig config;
-  config.corrupt_categories = {ErrorCategory::kBadCrc, ErrorCategory::kTruncated};
+  config.corrupt_categories = {wire::ErrorCategory::kBadCrc, wire::ErrorCategory::kTruncated};
   FaultPlan plan(config, 1);
-  EXPECT_EQ(plan.next_category(), ErrorCategory::kBadCrc);
-  EXPECT_EQ(plan.next_category(), ErrorCategory::kTruncated);
-  EXPECT_EQ(plan.next_category(), ErrorCategory::kBadCrc);
+  EXPECT_EQ(plan.next_category(), wire::ErrorCategory::kBadCrc);
+  EXPECT_EQ(plan.next_category(), wire::ErrorCategory::kTruncated);
+  EXPECT_EQ(plan.next_category(), wire::ErrorCategory::kBadCrc);
 }
 
 }  // namespace
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

@@ -10,24 +10,24 @@
 #include "simulator.hpp"
 #include "udp_stream.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 namespace {
 
 using namespace std::chrono_literals;
 
 class Loopback : public ::testing::Test {
  protected:
-  UdpSocket receiver_ = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
-  Endpoint receiver_address_ = receiver_.local_endpoint();
-  UdpSocket sender_ = UdpSocket::for_sending_to(receiver_address_);
+  transport::UdpSocket receiver_ = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
+  transport::Endpoint receiver_address_ = receiver_.local_endpoint();
+  transport::UdpSocket sender_ = transport::UdpSocket::for_sending_to(receiver_address_);
   UdpLink link_{sender_, receiver_address_};
-  std::array<std::uint8_t, kMaxFrameBytes + 1> buffer_{};
+  std::array<std::uint8_t, wire::kMaxFrameBytes + 1> buffer_{};
 
   /// The next datagram, or a test failure after a generous timeout (a lost datagram, not a slow one).
-  DecodeResult receive(Endpoint* from = nullptr) {
+  wire::DecodeResult receive(transport::Endpoint* from = nullptr) {
     const auto size = receiver_.receive(buffer_, from, 5s);
     EXPECT_TRUE(size.has_value()) << "no datagram within 5 s";
-    return decode(std::span(buffer_).first(size.value_or(0)));
+    return wire::decode(std::span(buffer_).first(size.value_or(0)));
   }
 };
 
@@ -37,10 +37,10 @@ TEST_F(Loopback, EveryFrameArrivesAndDecodes) {
   // Lockstep, one datagram in flight: nothing can overflow the receive buffer.
   for (std::uint64_t frame = 0; frame < 300; ++frame) {
     sim.step(link_);
-    const DecodeResult decoded = receive();
+    const wire::DecodeResult decoded = receive();
     ASSERT_TRUE(decoded) << "frame " << frame << ": " << decoded.error().message();
     EXPECT_EQ(decoded.frame().packet_number(), frame % 16);
-    EXPECT_EQ(decoded.frame().selection(), Selection::all());
+    EXPECT_EQ(decoded.frame().selection(), wire::Selection::all());
   }
   EXPECT_EQ(sim.report().sent, 300U);
   EXPECT_EQ(sim.report().valid, 300U);
@@ -50,14 +50,14 @@ TEST_F(Loopback, SelectionRequestToTheSourceAddressTakesEffect) {
   Simulator sim(SimConfig{});
   std::ostringstream log;
   sim.step(link_);
-  Endpoint robot;
+  transport::Endpoint robot;
   ASSERT_TRUE(receive(&robot));
 
-  Selection wanted;
-  wanted.add(Field::q);
-  wanted.add(Field::time);
-  std::array<std::uint8_t, kSelectionRequestBytes> request{};
-  ASSERT_TRUE(encode_selection_request(0, wanted, request));
+  wire::Selection wanted;
+  wanted.add(wire::Field::q);
+  wanted.add(wire::Field::time);
+  std::array<std::uint8_t, wire::kSelectionRequestBytes> request{};
+  ASSERT_TRUE(wire::encode_selection_request(0, wanted, request));
   ASSERT_TRUE(receiver_.send_to(request, robot));
   const std::array<std::uint8_t, 5> garbage = {1, 2, 3, 4, 5};
   ASSERT_TRUE(receiver_.send_to(garbage, robot));
@@ -74,7 +74,7 @@ TEST_F(Loopback, SelectionRequestToTheSourceAddressTakesEffect) {
   EXPECT_NE(log.str().find("q,time"), std::string::npos) << log.str();
 
   sim.step(link_);
-  const DecodeResult decoded = receive();
+  const wire::DecodeResult decoded = receive();
   ASSERT_TRUE(decoded);
   EXPECT_EQ(decoded.frame().selection(), wanted);
 }
@@ -82,10 +82,10 @@ TEST_F(Loopback, SelectionRequestToTheSourceAddressTakesEffect) {
 TEST_F(Loopback, StreamStopsAtTheCountAndSendsThemAll) {
   SimConfig config;
   config.rate_hz = 20000;
-  config.schedule = Schedule(Selection{});
+  config.schedule = Schedule(wire::Selection{});
   config.schedule.add(1, [] {
-    Selection joints;
-    joints.add(Field::q);
+    wire::Selection joints;
+    joints.add(wire::Field::q);
     return joints;
   }());
   Simulator sim(config);
@@ -108,4 +108,4 @@ TEST_F(Loopback, StreamReturnsAtOnceWhenStopped) {
 }
 
 }  // namespace
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

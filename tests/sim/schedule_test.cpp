@@ -2,17 +2,17 @@
 
 #include <gtest/gtest.h>
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 namespace {
 
-Selection fields(std::initializer_list<Field> list) {
-  Selection selection;
-  for (Field field : list) selection.add(field);
+wire::Selection fields(std::initializer_list<wire::Field> list) {
+  wire::Selection selection;
+  for (wire::Field field : list) selection.add(field);
   return selection;
 }
 
-Selection group(std::size_t g) {
-  Selection selection;
+wire::Selection group(std::size_t g) {
+  wire::Selection selection;
   selection.add_group(g);
   return selection;
 }
@@ -24,10 +24,10 @@ TEST(Schedule, FrameCarriesTheUnionOfEntriesWhosePeriodDividesIt) {
   ASSERT_TRUE(schedule.add("100:g1", error)) << error;
   ASSERT_TRUE(schedule.add("3:tau_J", error)) << error;
 
-  const Selection joints = fields({Field::q, Field::dq, Field::time});
-  EXPECT_EQ(schedule.at(0), unite(unite(joints, group(1)), fields({Field::tau_J})));
+  const wire::Selection joints = fields({wire::Field::q, wire::Field::dq, wire::Field::time});
+  EXPECT_EQ(schedule.at(0), unite(unite(joints, group(1)), fields({wire::Field::tau_J})));
   EXPECT_EQ(schedule.at(1), joints);
-  EXPECT_EQ(schedule.at(3), unite(joints, fields({Field::tau_J})));
+  EXPECT_EQ(schedule.at(3), unite(joints, fields({wire::Field::tau_J})));
   EXPECT_EQ(schedule.at(100), unite(joints, group(1)));
   EXPECT_EQ(schedule.at(300), schedule.at(0));
 }
@@ -36,22 +36,23 @@ TEST(Schedule, UncoveredFrameCarriesNothing) {
   Schedule schedule;
   std::string error;
   ASSERT_TRUE(schedule.add("2:q", error));
-  EXPECT_EQ(schedule.at(1), Selection{});
+  EXPECT_EQ(schedule.at(1), wire::Selection{});
   EXPECT_EQ(schedule.at(1).data_bytes(), 0);
 }
 
 TEST(Schedule, ConstantScheduleIsTheSameEveryFrame) {
-  const Schedule schedule(Selection::all());
-  for (std::uint64_t frame : {0ULL, 1ULL, 17ULL, 1ULL << 40}) EXPECT_EQ(schedule.at(frame), Selection::all());
+  const Schedule schedule(wire::Selection::all());
+  for (std::uint64_t frame : {0ULL, 1ULL, 17ULL, 1ULL << 40})
+    EXPECT_EQ(schedule.at(frame), wire::Selection::all());
 }
 
 TEST(Schedule, ItemsMixFieldsGroupsAndAll) {
-  Selection selection;
+  wire::Selection selection;
   std::string error;
   ASSERT_TRUE(parse_selection_items("g0, q ,g5", selection, error)) << error;
-  EXPECT_EQ(selection, unite(unite(group(0), group(5)), fields({Field::q})));
+  EXPECT_EQ(selection, unite(unite(group(0), group(5)), fields({wire::Field::q})));
   ASSERT_TRUE(parse_selection_items("all", selection, error));
-  EXPECT_EQ(selection, Selection::all());
+  EXPECT_EQ(selection, wire::Selection::all());
 }
 
 TEST(Schedule, RejectsMalformedEntriesNamingTheCulprit) {
@@ -70,4 +71,4 @@ TEST(Schedule, RejectsMalformedEntriesNamingTheCulprit) {
 }
 
 }  // namespace
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

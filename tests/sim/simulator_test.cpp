@@ -9,7 +9,7 @@
 
 #include "rsg/wire/json.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 namespace {
 
 using namespace std::chrono_literals;
@@ -27,12 +27,12 @@ class CapturingSink final : public DatagramSink {
 // What a receiver counts: valid frames, and invalid ones by category.
 struct Tally {
   std::uint64_t valid = 0;
-  std::array<std::uint64_t, kErrorCategoryCount> invalid{};
-  std::vector<StateValues> frames;
+  std::array<std::uint64_t, wire::kErrorCategoryCount> invalid{};
+  std::vector<wire::StateValues> frames;
 
   explicit Tally(const CapturingSink& sink) {
     for (const auto& datagram : sink.datagrams) {
-      const DecodeResult decoded = decode(datagram);
+      const wire::DecodeResult decoded = wire::decode(datagram);
       if (!decoded) {
         ++invalid[static_cast<std::size_t>(decoded.error().category()) - 1];
         continue;
@@ -67,7 +67,7 @@ TEST(Simulator, CleanStreamNumbersFramesAndStampsTime) {
   ASSERT_EQ(tally.frames.size(), 40U);
   for (std::size_t i = 0; i < tally.frames.size(); ++i) {
     EXPECT_EQ(tally.frames[i].packet_number, i % 16);
-    EXPECT_EQ(tally.frames[i].integer(Field::time), 2 * i);  // 500 Hz: 2 ms apart
+    EXPECT_EQ(tally.frames[i].integer(wire::Field::time), 2 * i);  // 500 Hz: 2 ms apart
   }
 }
 
@@ -79,7 +79,7 @@ TEST(Simulator, AboveOneKilohertzTimeRepeatsWholeMilliseconds) {
   run(sim, sink, 12);
   const Tally tally(sink);
   for (std::size_t i = 0; i < tally.frames.size(); ++i)
-    EXPECT_EQ(tally.frames[i].integer(Field::time), i / 4);
+    EXPECT_EQ(tally.frames[i].integer(wire::Field::time), i / 4);
 }
 
 TEST(Simulator, FollowsTheSchedulePerFrame) {
@@ -92,8 +92,8 @@ TEST(Simulator, FollowsTheSchedulePerFrame) {
   const Tally tally(sink);
   ASSERT_EQ(tally.frames.size(), 9U);
   for (std::size_t i = 0; i < tally.frames.size(); ++i) {
-    EXPECT_TRUE(tally.frames[i].selection.contains(Field::q));
-    EXPECT_EQ(tally.frames[i].selection.contains(Field::time), i % 4 == 0) << "frame " << i;
+    EXPECT_TRUE(tally.frames[i].selection.contains(wire::Field::q));
+    EXPECT_EQ(tally.frames[i].selection.contains(wire::Field::time), i % 4 == 0) << "frame " << i;
   }
 }
 
@@ -135,7 +135,7 @@ TEST(Simulator, DeterministicFaultsLandWhereAsked) {
   EXPECT_EQ(report.duplicated, 2U);
   EXPECT_EQ(report.reordered, 4U);
   std::vector<int> packet_numbers;
-  for (const StateValues& frame : tally.frames) packet_numbers.push_back(frame.packet_number);
+  for (const wire::StateValues& frame : tally.frames) packet_numbers.push_back(frame.packet_number);
   const std::vector<int> expected = {0, 1, 2, 4, 3, 5, 6, 6, 8, 7, 10, 12, 11, 13, 13, 14, 0, 15, 1, 2};
   EXPECT_EQ(packet_numbers, expected);
 }
@@ -157,7 +157,7 @@ TEST(Simulator, RecordsEveryValidDatagramInSendOrder) {
   std::size_t index = 0;
   while (std::getline(lines, line)) {
     ASSERT_LT(index, tally.frames.size());
-    EXPECT_EQ(line, to_canonical_json(tally.frames[index++]));
+    EXPECT_EQ(line, wire::to_canonical_json(tally.frames[index++]));
   }
   EXPECT_EQ(index, tally.frames.size());
   EXPECT_EQ(index, sim.report().valid);
@@ -171,9 +171,9 @@ TEST(Simulator, RestartBeginsTimeAndPacketNumbersAgain) {
   const SimReport report = run(sim, sink, 30);
   const Tally tally(sink);
   EXPECT_EQ(report.restarts, 1U);
-  EXPECT_EQ(tally.frames[19].integer(Field::time), 19U);
+  EXPECT_EQ(tally.frames[19].integer(wire::Field::time), 19U);
   EXPECT_EQ(tally.frames[19].packet_number, 3);
-  EXPECT_EQ(tally.frames[20].integer(Field::time), 0U);
+  EXPECT_EQ(tally.frames[20].integer(wire::Field::time), 0U);
   EXPECT_EQ(tally.frames[20].packet_number, 0);
   EXPECT_EQ(tally.frames[29].packet_number, 9);
 }
@@ -189,8 +189,8 @@ TEST(Simulator, PauseSilencesTheLinkWhileTheClockRuns) {
   EXPECT_EQ(sim.step(sink), 0ns);
   const Tally tally(sink);
   EXPECT_EQ(sim.report().pauses, 1U);
-  EXPECT_EQ(tally.frames[9].integer(Field::time), 9U);
-  EXPECT_EQ(tally.frames[10].integer(Field::time), 260U);
+  EXPECT_EQ(tally.frames[9].integer(wire::Field::time), 9U);
+  EXPECT_EQ(tally.frames[10].integer(wire::Field::time), 260U);
   EXPECT_EQ(tally.frames[10].packet_number, 10);
 }
 
@@ -199,11 +199,11 @@ TEST(Simulator, SelectionRequestReplacesTheSchedule) {
   CapturingSink sink;
   sim.step(sink);
 
-  Selection wanted;
-  wanted.add(Field::tau_J);
+  wire::Selection wanted;
+  wanted.add(wire::Field::tau_J);
   wanted.add_group(5);
-  std::array<std::uint8_t, kSelectionRequestBytes> request{};
-  ASSERT_TRUE(encode_selection_request(0, wanted, request));
+  std::array<std::uint8_t, wire::kSelectionRequestBytes> request{};
+  ASSERT_TRUE(wire::encode_selection_request(0, wanted, request));
   EXPECT_TRUE(sim.handle_request(request));
   sim.step(sink);
 
@@ -237,18 +237,18 @@ TEST(SimReport, JsonHasEveryCounterAndCategory) {
   SimReport report;
   report.sent = 10;
   report.valid = 7;
-  report.invalid_count(ErrorCategory::kBadCrc) = 2;
-  report.invalid_count(ErrorCategory::kBadValue) = 1;
+  report.invalid_count(wire::ErrorCategory::kBadCrc) = 2;
+  report.invalid_count(wire::ErrorCategory::kBadValue) = 1;
   const auto json = nlohmann::json::parse(report.to_json());
   EXPECT_EQ(json["sent"], 10);
   EXPECT_EQ(json["valid"], 7);
   EXPECT_EQ(json["invalid"]["bad_crc"], 2);
   EXPECT_EQ(json["invalid"]["bad_value"], 1);
-  EXPECT_EQ(json["invalid"].size(), kErrorCategoryCount);
+  EXPECT_EQ(json["invalid"].size(), wire::kErrorCategoryCount);
   for (const char* key : {"dropped", "duplicated", "reordered", "restarts", "pauses", "selection_requests",
                           "invalid_requests", "send_failures"})
     EXPECT_EQ(json[key], 0) << key;
 }
 
 }  // namespace
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

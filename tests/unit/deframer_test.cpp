@@ -9,10 +9,10 @@
 namespace rsg {
 namespace {
 
-std::vector<std::uint8_t> encode_state(const StateValues& values) {
-  std::vector<std::uint8_t> frame(kMaxFrameBytes);
-  const EncodeResult result =
-      encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), frame);
+std::vector<std::uint8_t> encode_state(const wire::StateValues& values) {
+  std::vector<std::uint8_t> frame(wire::kMaxFrameBytes);
+  const wire::EncodeResult result =
+      encode(values.packet_number, values.selection, values.storage(), wire::StateValues::layout(), frame);
   frame.resize(result.size);
   return frame;
 }
@@ -43,7 +43,7 @@ Stream make_stream(std::mt19937_64& rng, int frames, bool with_garbage) {
   return stream;
 }
 
-std::vector<std::vector<std::uint8_t>> feed_in_chunks(Deframer& deframer,
+std::vector<std::vector<std::uint8_t>> feed_in_chunks(wire::Deframer& deframer,
                                                       const std::vector<std::uint8_t>& bytes,
                                                       std::mt19937_64& rng, std::size_t max_chunk) {
   std::vector<std::vector<std::uint8_t>> found;
@@ -62,7 +62,7 @@ TEST(Deframer, FindsEveryFrameInArbitraryChunks) {
   std::mt19937_64 rng(1);
   for (std::size_t max_chunk : {1UL, 7UL, 100UL, 3000UL, 100000UL}) {
     const Stream stream = make_stream(rng, 50, false);
-    Deframer deframer;
+    wire::Deframer deframer;
     EXPECT_EQ(feed_in_chunks(deframer, stream.bytes, rng, max_chunk), stream.frames) << "chunk " << max_chunk;
     EXPECT_EQ(deframer.skipped_bytes(), 0U);
     EXPECT_EQ(deframer.pending_bytes(), 0U);
@@ -72,7 +72,7 @@ TEST(Deframer, FindsEveryFrameInArbitraryChunks) {
 TEST(Deframer, ResynchronisesAfterGarbageAndCountsIt) {
   std::mt19937_64 rng(2);
   const Stream stream = make_stream(rng, 200, true);
-  Deframer deframer;
+  wire::Deframer deframer;
   const auto found = feed_in_chunks(deframer, stream.bytes, rng, 500);
   EXPECT_EQ(found, stream.frames);
   EXPECT_EQ(deframer.skipped_bytes(), stream.garbage);
@@ -84,7 +84,7 @@ TEST(Deframer, SkipsAFrameWithABadCrcAndFindsTheNext) {
   const Stream stream = make_stream(rng, 3, false);
   auto bytes = stream.bytes;
   bytes[stream.frames[0].size() - 1] ^= 0xFF;  // first frame's CRC
-  Deframer deframer;
+  wire::Deframer deframer;
   const auto found = feed_in_chunks(deframer, bytes, rng, 64);
   ASSERT_EQ(found.size(), 2U);
   EXPECT_EQ(found[0], stream.frames[1]);
@@ -95,7 +95,7 @@ TEST(Deframer, SkipsAFrameWithABadCrcAndFindsTheNext) {
 TEST(Deframer, HoldsBackAPartialFrame) {
   std::mt19937_64 rng(4);
   const Stream stream = make_stream(rng, 1, false);
-  Deframer deframer;
+  wire::Deframer deframer;
   int frames = 0;
   deframer.feed({stream.bytes.data(), stream.bytes.size() - 1}, [&](auto) { ++frames; });
   EXPECT_EQ(frames, 0);

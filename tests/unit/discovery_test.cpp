@@ -15,14 +15,14 @@ namespace fdds = eprosima::fastdds::dds;
 using eprosima::fastrtps::rtps::DiscoveryProtocol_t;
 using eprosima::fastrtps::rtps::IPLocator;
 
-DiscoveryOptions servers(std::vector<std::string> values) {
-  DiscoveryOptions options;
+dds::DiscoveryOptions servers(std::vector<std::string> values) {
+  dds::DiscoveryOptions options;
   options.servers = std::move(values);
   return options;
 }
 
-DiscoveryOptions peers(std::vector<std::string> values) {
-  DiscoveryOptions options;
+dds::DiscoveryOptions peers(std::vector<std::string> values) {
+  dds::DiscoveryOptions options;
   options.peers = std::move(values);
   return options;
 }
@@ -37,7 +37,7 @@ std::string prefix_of(const eprosima::fastdds::rtps::RemoteServerAttributes& ser
 // third byte is the id.
 TEST(Discovery, ServersBecomeClientOfTheIdsFastddsDiscoveryUses) {
   fdds::DomainParticipantQos qos;
-  apply_discovery(servers({"198.18.0.2:11811", "198.18.0.3:11812", "7@198.18.0.4:11813"}), 0, qos);
+  dds::apply_discovery(servers({"198.18.0.2:11811", "198.18.0.3:11812", "7@198.18.0.4:11813"}), 0, qos);
   const auto& config = qos.wire_protocol().builtin.discovery_config;
   EXPECT_EQ(config.discoveryProtocol, DiscoveryProtocol_t::CLIENT);
   ASSERT_EQ(config.m_DiscoveryServers.size(), 3u);
@@ -53,13 +53,13 @@ TEST(Discovery, ServersBecomeClientOfTheIdsFastddsDiscoveryUses) {
 }
 
 TEST(Discovery, TheXmlExampleIsTheSameClient) {
-  load_profiles(default_profiles_dir());
+  dds::load_profiles(dds::default_profiles_dir());
   fdds::DomainParticipantQos from_xml;
   ASSERT_EQ(fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
                 "rsg_discovery_client", from_xml),
             ReturnCode_t::RETCODE_OK);
   fdds::DomainParticipantQos from_flag;
-  apply_discovery(servers({"127.0.0.1:11811"}), 0, from_flag);
+  dds::apply_discovery(servers({"127.0.0.1:11811"}), 0, from_flag);
   EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.discoveryProtocol, DiscoveryProtocol_t::CLIENT);
   EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.m_DiscoveryServers,
             from_flag.wire_protocol().builtin.discovery_config.m_DiscoveryServers);
@@ -71,7 +71,7 @@ TEST(Discovery, TheXmlExampleIsTheSameClient) {
 
 TEST(Discovery, APeerWithoutPortCoversEveryGatewayParticipantId) {
   fdds::DomainParticipantQos qos;
-  apply_discovery(peers({"198.18.0.2", "198.18.0.3:7412"}), 3, qos);
+  dds::apply_discovery(peers({"198.18.0.2", "198.18.0.3:7412"}), 3, qos);
   const auto& peers = qos.wire_protocol().builtin.initialPeersList;
   ASSERT_EQ(peers.size(), 61u);
   // Metatraffic unicast port of participant id i on domain 3: 7400 + 250 * 3 + 10 + 2 * i.
@@ -85,7 +85,7 @@ TEST(Discovery, APeerWithoutPortCoversEveryGatewayParticipantId) {
 // rsg_participant announces every 0.5 s (a late joiner's lost reply, xml_profiles/rsg.xml); with a
 // server or unicast peers every announcement goes to each of them, so those keep Fast DDS's 3 s.
 TEST(Discovery, MulticastAnnouncesEveryHalfSecondServersAndPeersAtFastDdsDefault) {
-  load_profiles(default_profiles_dir());
+  dds::load_profiles(dds::default_profiles_dir());
   const eprosima::fastrtps::Duration_t half_second(0, 500'000'000);
   const auto fastdds_default = eprosima::fastrtps::rtps::DiscoverySettings().leaseDuration_announcementperiod;
   ASSERT_NE(fastdds_default, half_second);
@@ -96,7 +96,7 @@ TEST(Discovery, MulticastAnnouncesEveryHalfSecondServersAndPeersAtFastDdsDefault
     EXPECT_EQ(qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod, half_second)
         << profile;
     fdds::DomainParticipantQos multicast = qos;
-    apply_discovery(DiscoveryOptions{}, 0, multicast);
+    dds::apply_discovery(dds::DiscoveryOptions{}, 0, multicast);
     EXPECT_EQ(multicast.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod,
               half_second);
     fdds::DomainParticipantQos client = qos;
@@ -111,14 +111,14 @@ TEST(Discovery, MulticastAnnouncesEveryHalfSecondServersAndPeersAtFastDdsDefault
 }
 
 TEST(Discovery, BadValuesNameThemselves) {
-  EXPECT_NE(check_discovery_server("198.18.0.2").find("HOST:PORT"), std::string::npos);
-  EXPECT_NE(check_discovery_server("256@h:1").find("0..255"), std::string::npos);
-  EXPECT_NE(check_peer("h:70000").find("1..65535"), std::string::npos);
-  EXPECT_EQ(check_peer("h"), "");
+  EXPECT_NE(transport::check_discovery_server("198.18.0.2").find("HOST:PORT"), std::string::npos);
+  EXPECT_NE(transport::check_discovery_server("256@h:1").find("0..255"), std::string::npos);
+  EXPECT_NE(transport::check_peer("h:70000").find("1..65535"), std::string::npos);
+  EXPECT_EQ(transport::check_peer("h"), "");
   fdds::DomainParticipantQos qos;
   try {
     // Syntax is checked before any name is resolved (no DNS query from a unit test).
-    apply_discovery(servers({"gw.plant"}), 0, qos);
+    dds::apply_discovery(servers({"gw.plant"}), 0, qos);
     FAIL() << "a server without a port was accepted";
   } catch (const std::invalid_argument& error) {
     EXPECT_NE(std::string(error.what()).find("gw.plant"), std::string::npos);

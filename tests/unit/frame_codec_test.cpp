@@ -41,10 +41,10 @@ class Arena {
   std::byte* aligned_;
 };
 
-Selection random_selection(std::mt19937_64& rng) {
-  Selection selection;
-  if (rng() % 3 == 0) return Selection::all();  // the usual frame, and the fast path
-  for (std::size_t group = 0; group < kGroupCount; ++group) {
+wire::Selection random_selection(std::mt19937_64& rng) {
+  wire::Selection selection;
+  if (rng() % 3 == 0) return wire::Selection::all();  // the usual frame, and the fast path
+  for (std::size_t group = 0; group < wire::kGroupCount; ++group) {
     if (rng() % 4 == 0) continue;
     selection.group_select |= static_cast<std::uint8_t>(1U << group);
     selection.data_select[group] = rng() % 2 ? 0xFF : static_cast<std::uint8_t>(rng());
@@ -54,16 +54,16 @@ Selection random_selection(std::mt19937_64& rng) {
 }
 
 /// Fields in a random order with random gaps: no kernel shortcut may assume field order.
-FieldLayout random_layout(std::mt19937_64& rng, std::size_t& size) {
-  std::array<std::size_t, kFieldCount> order{};
+wire::FieldLayout random_layout(std::mt19937_64& rng, std::size_t& size) {
+  std::array<std::size_t, wire::kFieldCount> order{};
   std::iota(order.begin(), order.end(), 0);
   if (rng() % 2) std::shuffle(order.begin(), order.end(), rng);
-  FieldLayout layout;
+  wire::FieldLayout layout;
   std::uint32_t offset = 0;
   for (const std::size_t index : order) {
     if (rng() % 3 == 0) offset += static_cast<std::uint32_t>(rng() % 9);
     layout.offsets[index] = offset;
-    offset += kFields[index].value_bytes();
+    offset += wire::kFields[index].value_bytes();
   }
   size = offset;
   return layout;
@@ -76,7 +76,7 @@ void fill_random(std::span<std::byte> bytes, std::mt19937_64& rng) {
 class StitchedKernel : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!detail::has_stitched_crc32()) GTEST_SKIP() << "no AVX-512 VPCLMULQDQ on this CPU";
+    if (!wire::detail::has_stitched_crc32()) GTEST_SKIP() << "no AVX-512 VPCLMULQDQ on this CPU";
   }
 };
 
@@ -92,7 +92,7 @@ class KernelCase {
         layout_(random_layout(rng, struct_size_)),
         plan_(selection_, layout_),
         frame_(reinterpret_cast<std::uint8_t*>(arena.at(kPage + anywhere_or_at_page_end(rng, 128))),
-               kHeaderBytes + selection_.data_bytes()),
+               wire::kHeaderBytes + selection_.data_bytes()),
         struct_(arena.at(4 * kPage + anywhere_or_at_page_end(rng, 160)), struct_size_),
         destination_(struct_is_destination ? struct_ : std::as_writable_bytes(frame_)) {
     fill_random({reinterpret_cast<std::byte*>(frame_.data()) - kMargin, frame_.size() + 2 * kMargin}, rng);
@@ -100,7 +100,7 @@ class KernelCase {
     expected_.assign(destination_.data() - kMargin, destination_.data() + destination_.size() + kMargin);
   }
 
-  const ChunkedCopyPlan& plan() const { return plan_; }
+  const wire::ChunkedCopyPlan& plan() const { return plan_; }
   std::span<std::uint8_t> frame() { return frame_; }
   std::byte* struct_base() { return struct_.data(); }
   /// The destination as the plain path sees it: inside the copy.
@@ -118,10 +118,10 @@ class KernelCase {
     return rng() % 2 ? kPage - rng() % reach : rng() % kPage;
   }
 
-  Selection selection_;
+  wire::Selection selection_;
   std::size_t struct_size_ = 0;
-  FieldLayout layout_;
-  ChunkedCopyPlan plan_;
+  wire::FieldLayout layout_;
+  wire::ChunkedCopyPlan plan_;
   std::span<std::uint8_t> frame_;
   std::span<std::byte> struct_;
   std::span<std::byte> destination_;
@@ -134,10 +134,10 @@ TEST_F(StitchedKernel, ScatterMatchesIsalAndMemcpy) {
   for (int round = 0; round < 20'000; ++round) {
     KernelCase input(rng, arena, /*struct_is_destination=*/true);
     const std::uint32_t expected =
-        detail::crc32_scatter_portable(input.frame(), input.plan(), input.expected_struct());
+        wire::detail::crc32_scatter_portable(input.frame(), input.plan(), input.expected_struct());
     const std::uint32_t actual =
-        detail::crc32_scatter_stitched(input.frame(), input.plan(), input.struct_base());
-    ASSERT_EQ(actual, crc32(input.frame())) << "round " << round;
+        wire::detail::crc32_scatter_stitched(input.frame(), input.plan(), input.struct_base());
+    ASSERT_EQ(actual, wire::crc32(input.frame())) << "round " << round;
     ASSERT_EQ(actual, expected);
     ASSERT_TRUE(input.same_as_expected()) << "round " << round;
   }
@@ -149,11 +149,11 @@ TEST_F(StitchedKernel, GatherMatchesMemcpyAndIsal) {
   for (int round = 0; round < 20'000; ++round) {
     KernelCase input(rng, arena, /*struct_is_destination=*/false);
     const std::uint32_t expected =
-        detail::gather_crc32_portable(input.expected_frame(), input.plan(), input.struct_base());
+        wire::detail::gather_crc32_portable(input.expected_frame(), input.plan(), input.struct_base());
     const std::uint32_t actual =
-        detail::gather_crc32_stitched(input.frame(), input.plan(), input.struct_base());
+        wire::detail::gather_crc32_stitched(input.frame(), input.plan(), input.struct_base());
     ASSERT_EQ(actual, expected) << "round " << round;
-    ASSERT_EQ(actual, crc32(input.frame()));
+    ASSERT_EQ(actual, wire::crc32(input.frame()));
     ASSERT_TRUE(input.same_as_expected()) << "round " << round;
   }
 }
@@ -164,23 +164,23 @@ TEST_F(StitchedKernel, EveryHeadPaddingASelectionCanHave) {
   // padding occurs; visit each one that does, with paddings 61 and 62, where the frame's first four
   // bytes (the inverted start of the CRC) straddle the first two chunks, among them.
   std::mt19937_64 rng(3);
-  std::array<std::uint8_t, kMaxFrameBytes> frame{};
+  std::array<std::uint8_t, wire::kMaxFrameBytes> frame{};
   std::set<std::size_t> paddings;
   for (int round = 0; round < 200'000; ++round) {
-    const Selection selection = random_selection(rng);
-    const ChunkedCopyPlan plan(selection, StateValues::layout());
+    const wire::Selection selection = random_selection(rng);
+    const wire::ChunkedCopyPlan plan(selection, wire::StateValues::layout());
     const std::size_t size = plan.plan().covered_bytes();
     if (size < 256 || !paddings.insert(plan.head_padding()).second) continue;
 
     const std::span covered = std::span(frame).first(size);
     for (std::uint8_t& byte : covered) byte = static_cast<std::uint8_t>(rng());
-    StateValues expected;
-    StateValues actual;
-    EXPECT_EQ(detail::crc32_scatter_stitched(covered, plan, static_cast<std::byte*>(actual.storage())),
-              crc32(covered))
+    wire::StateValues expected;
+    wire::StateValues actual;
+    EXPECT_EQ(wire::detail::crc32_scatter_stitched(covered, plan, static_cast<std::byte*>(actual.storage())),
+              wire::crc32(covered))
         << "padding " << plan.head_padding();
-    detail::copy_to_struct(covered, plan.plan(), static_cast<std::byte*>(expected.storage()));
-    EXPECT_EQ(std::memcmp(actual.storage(), expected.storage(), StateValues::storage_size()), 0)
+    wire::detail::copy_to_struct(covered, plan.plan(), static_cast<std::byte*>(expected.storage()));
+    EXPECT_EQ(std::memcmp(actual.storage(), expected.storage(), wire::StateValues::storage_size()), 0)
         << "padding " << plan.head_padding();
   }
   EXPECT_TRUE(paddings.contains(61) && paddings.contains(62));
@@ -188,39 +188,39 @@ TEST_F(StitchedKernel, EveryHeadPaddingASelectionCanHave) {
 }
 
 TEST(CopyPlan, FullSelectionIsAFewMovesAndLeavesOnlyErrorSetHighBytes) {
-  const CopyPlan plan(Selection::all(), StateValues::layout());
+  const wire::CopyPlan plan(wire::Selection::all(), wire::StateValues::layout());
   // StateValues stores fields in table order; the two 5-byte error sets widen to 8 bytes, which
   // shifts what follows each: the doubles with current_errors, last_motion_errors, the rest.
   EXPECT_EQ(plan.moves().size(), 3U);
   ASSERT_EQ(plan.fills().size(), 2U);
   EXPECT_EQ(plan.fills()[0].size, 3U);
   EXPECT_EQ(plan.fills()[1].size, 3U);
-  EXPECT_EQ(plan.covered_bytes(), kHeaderBytes + kMaxDataBytes);
-  const ChunkedCopyPlan chunked(Selection::all(), StateValues::layout());
-  EXPECT_EQ((plan.covered_bytes() + chunked.head_padding()) % kChunkBytes, 0U);
+  EXPECT_EQ(plan.covered_bytes(), wire::kHeaderBytes + wire::kMaxDataBytes);
+  const wire::ChunkedCopyPlan chunked(wire::Selection::all(), wire::StateValues::layout());
+  EXPECT_EQ((plan.covered_bytes() + chunked.head_padding()) % wire::kChunkBytes, 0U);
 }
 
 TEST(CopyPlan, EmptySelectionZeroesEverything) {
-  const CopyPlan plan(Selection{}, StateValues::layout());
+  const wire::CopyPlan plan(wire::Selection{}, wire::StateValues::layout());
   EXPECT_TRUE(plan.moves().empty());
   ASSERT_EQ(plan.fills().size(), 1U);
-  EXPECT_EQ(plan.fills()[0].size, StateValues::storage_size());
+  EXPECT_EQ(plan.fills()[0].size, wire::StateValues::storage_size());
 }
 
 TEST(FrameCodec, DecodesLikeDecodeThenCopyFields) {
   std::mt19937_64 rng(11);
-  FrameCodec codec(StateValues::layout());
-  std::array<std::uint8_t, kMaxFrameBytes> frame{};
+  wire::FrameCodec codec(wire::StateValues::layout());
+  std::array<std::uint8_t, wire::kMaxFrameBytes> frame{};
   for (int round = 0; round < 5'000; ++round) {
-    const StateValues original = test::random_state(rng);
-    const EncodeResult encoded =
-        encode(original.packet_number, original.selection, original.storage(), StateValues::layout(), frame);
+    const wire::StateValues original = test::random_state(rng);
+    const wire::EncodeResult encoded = encode(original.packet_number, original.selection, original.storage(),
+                                              wire::StateValues::layout(), frame);
     ASSERT_TRUE(encoded) << encoded.error.message();
     const std::span bytes = std::span(frame).first(encoded.size);
 
-    StateValues stale;  // a reused sample: every byte must be rewritten
-    std::memset(stale.storage(), 0x5A, StateValues::storage_size());
-    const DecodeResult decoded = codec.decode(bytes, stale.storage());
+    wire::StateValues stale;  // a reused sample: every byte must be rewritten
+    std::memset(stale.storage(), 0x5A, wire::StateValues::storage_size());
+    const wire::DecodeResult decoded = codec.decode(bytes, stale.storage());
     ASSERT_TRUE(decoded) << decoded.error().message();
     stale.packet_number = decoded.frame().packet_number();
     stale.selection = decoded.frame().selection();
@@ -230,12 +230,12 @@ TEST(FrameCodec, DecodesLikeDecodeThenCopyFields) {
 
 TEST(FrameCodec, RejectsWhatDecodeRejectsWithTheSameCategory) {
   std::mt19937_64 rng(12);
-  FrameCodec codec(StateValues::layout());
-  std::array<std::uint8_t, kMaxFrameBytes> frame{};
+  wire::FrameCodec codec(wire::StateValues::layout());
+  std::array<std::uint8_t, wire::kMaxFrameBytes> frame{};
   for (int round = 0; round < 5'000; ++round) {
-    const StateValues original = test::random_state(rng);
-    const EncodeResult encoded =
-        encode(original.packet_number, original.selection, original.storage(), StateValues::layout(), frame);
+    const wire::StateValues original = test::random_state(rng);
+    const wire::EncodeResult encoded = encode(original.packet_number, original.selection, original.storage(),
+                                              wire::StateValues::layout(), frame);
     ASSERT_TRUE(encoded);
     std::size_t size = encoded.size;
     switch (rng() % 3) {
@@ -246,13 +246,13 @@ TEST(FrameCodec, RejectsWhatDecodeRejectsWithTheSameCategory) {
         size = rng() % 2 ? size - 1 - rng() % size : std::min(size + 1 + rng() % 8, frame.size());
         break;
       default:  // a header byte replaced, CRC still over the original bytes
-        frame[rng() % kHeaderBytes] = static_cast<std::uint8_t>(rng());
+        frame[rng() % wire::kHeaderBytes] = static_cast<std::uint8_t>(rng());
         break;
     }
     const std::span bytes = std::span(frame).first(size);
-    const DecodeResult plain = decode(bytes);
-    StateValues values;
-    const DecodeResult stitched = codec.decode(bytes, values.storage());
+    const wire::DecodeResult plain = wire::decode(bytes);
+    wire::StateValues values;
+    const wire::DecodeResult stitched = codec.decode(bytes, values.storage());
     ASSERT_EQ(static_cast<bool>(stitched), static_cast<bool>(plain)) << "round " << round;
     ASSERT_EQ(stitched.error().category(), plain.error().category())
         << "round " << round << ": " << stitched.error().message() << " / " << plain.error().message();
@@ -261,25 +261,25 @@ TEST(FrameCodec, RejectsWhatDecodeRejectsWithTheSameCategory) {
 
 TEST(FrameCodec, EncodesLikeEncodeAndRefusesTheSameValues) {
   std::mt19937_64 rng(13);
-  FrameCodec codec(StateValues::layout());
-  std::array<std::uint8_t, kMaxFrameBytes> expected{};
-  std::array<std::uint8_t, kMaxFrameBytes> actual{};
+  wire::FrameCodec codec(wire::StateValues::layout());
+  std::array<std::uint8_t, wire::kMaxFrameBytes> expected{};
+  std::array<std::uint8_t, wire::kMaxFrameBytes> actual{};
   for (int round = 0; round < 2'000; ++round) {
-    StateValues values = test::random_state(rng);
-    if (round % 10 == 0 && values.selection.contains(Field::robot_mode))
-      values.set_integer(Field::robot_mode, 7);
-    if (round % 10 == 1 && values.selection.contains(Field::current_errors))
-      values.set_integer(Field::current_errors, std::uint64_t{1} << 38);
-    const EncodeResult plain =
-        encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), expected);
-    const EncodeResult stitched =
+    wire::StateValues values = test::random_state(rng);
+    if (round % 10 == 0 && values.selection.contains(wire::Field::robot_mode))
+      values.set_integer(wire::Field::robot_mode, 7);
+    if (round % 10 == 1 && values.selection.contains(wire::Field::current_errors))
+      values.set_integer(wire::Field::current_errors, std::uint64_t{1} << 38);
+    const wire::EncodeResult plain = encode(values.packet_number, values.selection, values.storage(),
+                                            wire::StateValues::layout(), expected);
+    const wire::EncodeResult stitched =
         codec.encode(values.packet_number, values.selection, values.storage(), actual);
     ASSERT_EQ(stitched.size, plain.size);
     ASSERT_EQ(stitched.error.category(), plain.error.category());
     ASSERT_TRUE(
         std::equal(actual.begin(), actual.begin() + static_cast<long>(stitched.size), expected.begin()));
     if (stitched) {
-      ASSERT_TRUE(decode(std::span(actual).first(stitched.size))) << "round " << round;
+      ASSERT_TRUE(wire::decode(std::span(actual).first(stitched.size))) << "round " << round;
     }
   }
 }

@@ -23,6 +23,7 @@
 #include "rsg/wire/frame.hpp"
 
 namespace rsg {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 constexpr int kWarmUp = 1'000;
@@ -32,11 +33,12 @@ std::vector<std::vector<std::uint8_t>> make_frames(int count) {
   std::mt19937_64 rng(5);
   std::vector<std::vector<std::uint8_t>> frames;
   for (int i = 0; i < count; ++i) {
-    StateValues values = test::random_state(rng);
+    wire::StateValues values = test::random_state(rng);
     values.packet_number = static_cast<std::uint8_t>(i % 16);
-    std::vector<std::uint8_t> frame(kMaxFrameBytes);
-    frame.resize(
-        encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), frame).size);
+    std::vector<std::uint8_t> frame(wire::kMaxFrameBytes);
+    frame.resize(wire::encode(values.packet_number, values.selection, values.storage(),
+                              wire::StateValues::layout(), frame)
+                     .size);
     frames.push_back(std::move(frame));
   }
   return frames;
@@ -45,7 +47,7 @@ std::vector<std::vector<std::uint8_t>> make_frames(int count) {
 TEST(HotPath, DecodeIntoASampleAllocatesNothing) {
   const auto frames = make_frames(64);
   RobotState sample;
-  RobotStateCodec codec;
+  dds::RobotStateCodec codec;
   std::size_t decoded = 0;
   test::AllocationCounter allocations;
   allocations.resume();
@@ -63,9 +65,9 @@ void expect_no_allocations_while_publishing(const std::string& profile, bool rea
   settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
   eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
   const int domain = static_cast<int>(::getpid() % 200 + 10);
-  load_profiles(std::filesystem::path(RSG_TEST_DATA_DIR) / "hot_path_profiles.xml");
-  Participant publishing(domain, profile);
-  Participant subscribing(domain, profile);
+  dds::load_profiles(std::filesystem::path(RSG_TEST_DATA_DIR) / "hot_path_profiles.xml");
+  dds::Participant publishing(domain, profile);
+  dds::Participant subscribing(domain, profile);
 
   fdds::DataWriterQos qos = fdds::DATAWRITER_QOS_DEFAULT;
   qos.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
@@ -96,7 +98,7 @@ void expect_no_allocations_while_publishing(const std::string& profile, bool rea
   ASSERT_EQ(matched.current_count, 1) << "the reader never matched";
 
   const auto frames = make_frames(64);
-  RobotStateCodec codec;
+  dds::RobotStateCodec codec;
   auto publish = [&](const std::vector<std::uint8_t>& frame) {
     void* loan = nullptr;
     if (writer->loan_sample(loan) != ReturnCode_t::RETCODE_OK) return false;

@@ -11,30 +11,30 @@ namespace {
 TEST(Json, SpecExampleRoundTrips) {
   const std::string text =
       R"({"packet_number":5,"group_select":4,"data_select":[0,0,32,0,0,0],"fields":{"q":[0.1,0.2,0.3,0.4,0.5,0.6,0.7]}})";
-  StateValues values;
+  wire::StateValues values;
   std::string error;
-  ASSERT_TRUE(parse_canonical_json(text, values, error)) << error;
-  EXPECT_EQ(values.doubles(Field::q)[6], 0.7);
-  EXPECT_EQ(to_canonical_json(values), text);
+  ASSERT_TRUE(wire::parse_canonical_json(text, values, error)) << error;
+  EXPECT_EQ(values.doubles(wire::Field::q)[6], 0.7);
+  EXPECT_EQ(wire::to_canonical_json(values), text);
 }
 
 TEST(Json, SpecialValuesAndScalars) {
-  StateValues values;
-  values.selection.add(Field::m_ee);
-  values.selection.add(Field::q);
-  values.selection.add(Field::current_errors);
-  values.selection.add(Field::robot_mode);
-  values.selection.add(Field::time);
-  values.doubles(Field::m_ee)[0] = -0.0;
-  auto q = values.doubles(Field::q);
+  wire::StateValues values;
+  values.selection.add(wire::Field::m_ee);
+  values.selection.add(wire::Field::q);
+  values.selection.add(wire::Field::current_errors);
+  values.selection.add(wire::Field::robot_mode);
+  values.selection.add(wire::Field::time);
+  values.doubles(wire::Field::m_ee)[0] = -0.0;
+  auto q = values.doubles(wire::Field::q);
   q[0] = std::nan("");
   q[1] = INFINITY;
   q[2] = -INFINITY;
   q[3] = 8.0;
-  values.set_integer(Field::current_errors, 0b101);
-  values.set_integer(Field::robot_mode, 2);
-  values.set_integer(Field::time, 18446744073709551615ULL);
-  const std::string json = to_canonical_json(values);
+  values.set_integer(wire::Field::current_errors, 0b101);
+  values.set_integer(wire::Field::robot_mode, 2);
+  values.set_integer(wire::Field::time, 18446744073709551615ULL);
+  const std::string json = wire::to_canonical_json(values);
   EXPECT_NE(json.find(R"("m_ee":-0.0)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("q":["nan","inf","-inf",8,0,0,0])"), std::string::npos) << json;
   EXPECT_NE(
@@ -43,12 +43,12 @@ TEST(Json, SpecialValuesAndScalars) {
       std::string::npos);
   EXPECT_NE(json.find(R"("time":18446744073709551615)"), std::string::npos);
 
-  StateValues parsed;
+  wire::StateValues parsed;
   std::string error;
-  ASSERT_TRUE(parse_canonical_json(json, parsed, error)) << error;
-  EXPECT_TRUE(std::signbit(parsed.doubles(Field::m_ee)[0]));
-  EXPECT_TRUE(std::isnan(parsed.doubles(Field::q)[0]));
-  EXPECT_EQ(parsed.integer(Field::time), 18446744073709551615ULL);
+  ASSERT_TRUE(wire::parse_canonical_json(json, parsed, error)) << error;
+  EXPECT_TRUE(std::signbit(parsed.doubles(wire::Field::m_ee)[0]));
+  EXPECT_TRUE(std::isnan(parsed.doubles(wire::Field::q)[0]));
+  EXPECT_EQ(parsed.integer(wire::Field::time), 18446744073709551615ULL);
 }
 
 struct BadInput {
@@ -59,9 +59,9 @@ struct BadInput {
 class JsonErrors : public testing::TestWithParam<BadInput> {};
 
 TEST_P(JsonErrors, AreReadable) {
-  StateValues values;
+  wire::StateValues values;
   std::string error;
-  EXPECT_FALSE(parse_canonical_json(GetParam().json, values, error));
+  EXPECT_FALSE(wire::parse_canonical_json(GetParam().json, values, error));
   EXPECT_NE(error.find(GetParam().expected_error), std::string::npos) << error;
 }
 

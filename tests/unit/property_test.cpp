@@ -12,16 +12,16 @@ constexpr int kRounds = 10'000;
 
 TEST(Property, EncodeThenDecodeIsExact) {
   std::mt19937_64 rng(20261121);
-  std::array<std::uint8_t, kMaxFrameBytes> frame{};
+  std::array<std::uint8_t, wire::kMaxFrameBytes> frame{};
   for (int round = 0; round < kRounds; ++round) {
-    const StateValues original = test::random_state(rng);
-    const EncodeResult encoded =
-        encode(original.packet_number, original.selection, original.storage(), StateValues::layout(), frame);
+    const wire::StateValues original = test::random_state(rng);
+    const wire::EncodeResult encoded = encode(original.packet_number, original.selection, original.storage(),
+                                              wire::StateValues::layout(), frame);
     ASSERT_TRUE(encoded) << encoded.error.message();
-    ASSERT_EQ(encoded.size, kMinFrameBytes + original.selection.data_bytes());
-    const DecodeResult decoded = decode({frame.data(), encoded.size});
+    ASSERT_EQ(encoded.size, wire::kMinFrameBytes + original.selection.data_bytes());
+    const wire::DecodeResult decoded = wire::decode({frame.data(), encoded.size});
     ASSERT_TRUE(decoded) << decoded.error().message();
-    StateValues copy;
+    wire::StateValues copy;
     copy.assign(decoded.frame());
     ASSERT_EQ(copy, original) << "round " << round;  // bitwise: NaN payloads and -0.0 survive
   }
@@ -30,11 +30,11 @@ TEST(Property, EncodeThenDecodeIsExact) {
 TEST(Property, CanonicalJsonRoundTripsExactly) {
   std::mt19937_64 rng(7);
   for (int round = 0; round < kRounds; ++round) {
-    const StateValues original = test::random_state(rng, /*allow_nan_payloads=*/false);
-    StateValues parsed;
+    const wire::StateValues original = test::random_state(rng, /*allow_nan_payloads=*/false);
+    wire::StateValues parsed;
     std::string error;
-    const std::string json = to_canonical_json(original);
-    ASSERT_TRUE(parse_canonical_json(json, parsed, error)) << error << "\n" << json;
+    const std::string json = wire::to_canonical_json(original);
+    ASSERT_TRUE(wire::parse_canonical_json(json, parsed, error)) << error << "\n" << json;
     ASSERT_EQ(parsed, original) << json;
   }
 }
@@ -43,15 +43,15 @@ TEST(Property, EveryCorruptedByteIsRejectedOrDecodesToTheSameBytes) {
   // A single flipped byte anywhere must never yield a "valid" frame with other content,
   // short of a CRC collision, which a single-byte change cannot produce.
   std::mt19937_64 rng(99);
-  std::array<std::uint8_t, kMaxFrameBytes> frame{};
+  std::array<std::uint8_t, wire::kMaxFrameBytes> frame{};
   for (int round = 0; round < 500; ++round) {
-    const StateValues original = test::random_state(rng);
-    const EncodeResult encoded =
-        encode(original.packet_number, original.selection, original.storage(), StateValues::layout(), frame);
+    const wire::StateValues original = test::random_state(rng);
+    const wire::EncodeResult encoded = encode(original.packet_number, original.selection, original.storage(),
+                                              wire::StateValues::layout(), frame);
     ASSERT_TRUE(encoded);
     const std::size_t at = rng() % encoded.size;
     frame[at] ^= static_cast<std::uint8_t>(1 + rng() % 255);
-    EXPECT_FALSE(decode({frame.data(), encoded.size})) << "byte " << at;
+    EXPECT_FALSE(wire::decode({frame.data(), encoded.size})) << "byte " << at;
   }
 }
 

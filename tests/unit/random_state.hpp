@@ -30,28 +30,28 @@ inline double random_double(std::mt19937_64& rng, bool allow_nan_payloads) {
   }
 }
 
-inline StateValues random_state(std::mt19937_64& rng, bool allow_nan_payloads = true) {
-  StateValues values;
+inline wire::StateValues random_state(std::mt19937_64& rng, bool allow_nan_payloads = true) {
+  wire::StateValues values;
   values.packet_number = static_cast<std::uint8_t>(rng() % 16);
-  for (std::size_t group = 0; group < kGroupCount; ++group) {
+  for (std::size_t group = 0; group < wire::kGroupCount; ++group) {
     if (rng() % 4 == 0) continue;
     values.selection.group_select |= static_cast<std::uint8_t>(1U << group);
     values.selection.data_select[group] = static_cast<std::uint8_t>(rng());
   }
   values.selection.data_select[5] &= 0x0F;
-  for (const FieldInfo& field : kFields) {
+  for (const wire::FieldInfo& field : wire::kFields) {
     if (!values.selection.contains(field.id())) continue;
     switch (field.type) {
-      case ElementType::kFloat64:
+      case wire::ElementType::kFloat64:
         for (double& element : values.doubles(field.id())) element = random_double(rng, allow_nan_payloads);
         break;
-      case ElementType::kErrorSet:
-        values.set_integer(field.id(), rng() & ~(~std::uint64_t{0} << kErrorFlagCount));
+      case wire::ElementType::kErrorSet:
+        values.set_integer(field.id(), rng() & ~(~std::uint64_t{0} << wire::kErrorFlagCount));
         break;
-      case ElementType::kUInt8:
-        values.set_integer(field.id(), rng() % (kMaxRobotMode + 1));
+      case wire::ElementType::kUInt8:
+        values.set_integer(field.id(), rng() % (wire::kMaxRobotMode + 1));
         break;
-      case ElementType::kUInt64:
+      case wire::ElementType::kUInt64:
         values.set_integer(field.id(), rng());
         break;
     }

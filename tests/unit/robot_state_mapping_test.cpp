@@ -20,56 +20,57 @@ TEST(RobotStateType, IsPlainBoundedAndUnkeyed) {
 }
 
 TEST(RobotStateType, MembersDoNotOverlap) {
-  const FieldLayout& layout = robot_state_layout();
-  for (std::size_t i = 1; i < kFieldCount; ++i)
-    EXPECT_GE(layout.offsets[i], layout.offsets[i - 1] + kFields[i - 1].value_bytes()) << kFields[i].name;
-  EXPECT_LE(layout.offsets.back() + kFields.back().value_bytes(), sizeof(RobotState));
+  const wire::FieldLayout& layout = dds::robot_state_layout();
+  for (std::size_t i = 1; i < wire::kFieldCount; ++i)
+    EXPECT_GE(layout.offsets[i], layout.offsets[i - 1] + wire::kFields[i - 1].value_bytes())
+        << wire::kFields[i].name;
+  EXPECT_LE(layout.offsets.back() + wire::kFields.back().value_bytes(), sizeof(RobotState));
 }
 
 // Bytes of member `name` read through the generated accessor, not through our layout.
-std::vector<std::byte> member_bytes(RobotState& sample, Field field) {
+std::vector<std::byte> member_bytes(RobotState& sample, wire::Field field) {
   const std::byte* begin = nullptr;
   switch (field) {
 #define RSG_MEMBER_CASE(name, index, group, mask, type, count, bytes) \
-  case Field::name:                                                   \
+  case wire::Field::name:                                             \
     begin = reinterpret_cast<const std::byte*>(&sample.name());       \
     break;
     RSG_FIELDS(RSG_MEMBER_CASE)
 #undef RSG_MEMBER_CASE
   }
-  return {begin, begin + info(field).value_bytes()};
+  return {begin, begin + wire::info(field).value_bytes()};
 }
 
 TEST(RobotStateMapping, EachSingleFieldVectorLandsInItsOwnMember) {
-  std::array<bool, kFieldCount> covered{};
+  std::array<bool, wire::kFieldCount> covered{};
   for (const auto& vector : test::valid_vectors()) {
-    const DecodeResult result = decode(vector.frame);
+    const wire::DecodeResult result = wire::decode(vector.frame);
     ASSERT_TRUE(result);
-    const Selection& selection = result.frame().selection();
+    const wire::Selection& selection = result.frame().selection();
     int selected = 0;
-    Field only{};
-    for (const FieldInfo& field : kFields)
+    wire::Field only{};
+    for (const wire::FieldInfo& field : wire::kFields)
       if (selection.contains(field.id())) ++selected, only = field.id();
     if (selected != 1) continue;
     covered[static_cast<std::size_t>(only)] = true;
-    SCOPED_TRACE(info(only).name);
+    SCOPED_TRACE(wire::info(only).name);
 
     RobotState sample;
     // Poison every member, then decode into it.
     RobotState& poisoned = sample;
 #define RSG_POISON(name, index, group, mask, type, count, bytes) \
-  std::memset(static_cast<void*>(&poisoned.name()), 0x5A, kFields[index].value_bytes());
+  std::memset(static_cast<void*>(&poisoned.name()), 0x5A, wire::kFields[index].value_bytes());
     RSG_FIELDS(RSG_POISON)
 #undef RSG_POISON
-    to_sample(result.frame(), poisoned);
+    dds::to_sample(result.frame(), poisoned);
 
-    StateValues expected;
+    wire::StateValues expected;
     expected.assign(result.frame());
-    for (const FieldInfo& field : kFields) {
+    for (const wire::FieldInfo& field : wire::kFields) {
       const auto bytes = member_bytes(poisoned, field.id());
       if (field.id() == only) {
         const auto* want =
-            static_cast<const std::byte*>(StateValues::layout().locate(expected.storage(), only));
+            static_cast<const std::byte*>(wire::StateValues::layout().locate(expected.storage(), only));
         EXPECT_EQ(0, std::memcmp(bytes.data(), want, bytes.size()));
       } else {
         EXPECT_EQ(bytes, std::vector<std::byte>(bytes.size(), std::byte{0}))
@@ -77,7 +78,7 @@ TEST(RobotStateMapping, EachSingleFieldVectorLandsInItsOwnMember) {
       }
     }
     EXPECT_EQ(poisoned.group_select(), selection.group_select);
-    for (std::size_t g = 0; g < kGroupCount; ++g)
+    for (std::size_t g = 0; g < wire::kGroupCount; ++g)
       EXPECT_EQ(poisoned.group_present()[g], selection.has_group(g));
   }
   EXPECT_EQ(std::count(covered.begin(), covered.end(), true), 44) << "every field has a single-field vector";
@@ -85,12 +86,12 @@ TEST(RobotStateMapping, EachSingleFieldVectorLandsInItsOwnMember) {
 
 TEST(RobotStateMapping, EveryVectorRoundTripsThroughTheSampleByteForByte) {
   for (const auto& vector : test::valid_vectors()) {
-    const DecodeResult result = decode(vector.frame);
+    const wire::DecodeResult result = wire::decode(vector.frame);
     ASSERT_TRUE(result);
     RobotState sample;
-    to_sample(result.frame(), sample);
-    std::array<std::uint8_t, kMaxFrameBytes> out{};
-    const EncodeResult encoded = to_frame(sample, out);
+    dds::to_sample(result.frame(), sample);
+    std::array<std::uint8_t, wire::kMaxFrameBytes> out{};
+    const wire::EncodeResult encoded = dds::to_frame(sample, out);
     ASSERT_TRUE(encoded) << encoded.error.message();
     EXPECT_EQ(std::vector<std::uint8_t>(out.begin(), out.begin() + static_cast<long>(encoded.size)),
               vector.frame);
@@ -102,8 +103,8 @@ TEST(RobotStateMapping, RefusesASampleNoFrameCouldCarry) {
   sample.group_select(1 << 5);
   sample.data_select()[5] = 0x04;
   sample.robot_mode(9);
-  std::array<std::uint8_t, kMaxFrameBytes> out{};
-  EXPECT_EQ(to_frame(sample, out).error.category(), ErrorCategory::kBadValue);
+  std::array<std::uint8_t, wire::kMaxFrameBytes> out{};
+  EXPECT_EQ(dds::to_frame(sample, out).error.category(), wire::ErrorCategory::kBadValue);
 }
 
 }  // namespace

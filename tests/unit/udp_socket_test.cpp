@@ -14,24 +14,24 @@ namespace {
 using namespace std::chrono_literals;
 
 TEST(Endpoint, ParsesV4V6AndRejectsNonsense) {
-  EXPECT_EQ(Endpoint::parse("127.0.0.1:7000").to_string(), "127.0.0.1:7000");
-  EXPECT_EQ(Endpoint::parse("[::1]:7000").to_string(), "[::1]:7000");
-  EXPECT_EQ(Endpoint::parse(":7000").to_string(), "0.0.0.0:7000");
-  EXPECT_THROW(Endpoint::parse("127.0.0.1"), std::invalid_argument);
-  EXPECT_THROW(Endpoint::parse("127.0.0.1:notaport"), std::invalid_argument);
+  EXPECT_EQ(transport::Endpoint::parse("127.0.0.1:7000").to_string(), "127.0.0.1:7000");
+  EXPECT_EQ(transport::Endpoint::parse("[::1]:7000").to_string(), "[::1]:7000");
+  EXPECT_EQ(transport::Endpoint::parse(":7000").to_string(), "0.0.0.0:7000");
+  EXPECT_THROW(transport::Endpoint::parse("127.0.0.1"), std::invalid_argument);
+  EXPECT_THROW(transport::Endpoint::parse("127.0.0.1:notaport"), std::invalid_argument);
 }
 
 TEST(UdpSocket, RoundTripReportsSourceAndTrueSize) {
-  UdpSocket receiver = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
-  UdpSocket sender = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
-  const Endpoint to = receiver.local_endpoint();
+  transport::UdpSocket receiver = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
+  transport::UdpSocket sender = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
+  const transport::Endpoint to = receiver.local_endpoint();
   ASSERT_NE(to.port(), 0);
 
   std::array<std::uint8_t, 3000> big{};
   big[0] = 0x30;
   ASSERT_TRUE(sender.send_to(big, to));
   std::array<std::uint8_t, 2200> buffer{};
-  Endpoint from;
+  transport::Endpoint from;
   const auto size = receiver.receive(buffer, &from, 1000ms);
   ASSERT_TRUE(size.has_value());
   EXPECT_EQ(*size, big.size()) << "an oversized datagram must be reported with its real size";
@@ -43,7 +43,7 @@ class ReceiveBatch : public ::testing::Test {
  protected:
   // Datagrams sent over loopback are queued by the time send_to returns; waiting for the first
   // one still makes the tests independent of that.
-  std::size_t receive(DatagramBatch& batch) {
+  std::size_t receive(transport::DatagramBatch& batch) {
     if (!receiver_.wait_readable(1000ms)) return 0;
     return receiver_.receive_batch(batch);
   }
@@ -54,18 +54,18 @@ class ReceiveBatch : public ::testing::Test {
     return bytes;
   }
 
-  UdpSocket receiver_ = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
-  UdpSocket sender_a_ = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
-  UdpSocket sender_b_ = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
+  transport::UdpSocket receiver_ = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
+  transport::UdpSocket sender_a_ = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
+  transport::UdpSocket sender_b_ = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
 };
 
 TEST_F(ReceiveBatch, TakesSeveralDatagramsInOneCallInOrderWithTheirSenders) {
-  const Endpoint to = receiver_.local_endpoint();
+  const transport::Endpoint to = receiver_.local_endpoint();
   ASSERT_TRUE(sender_a_.send_to(datagram(10, 1), to));
   ASSERT_TRUE(sender_b_.send_to(datagram(20, 2), to));
   ASSERT_TRUE(sender_a_.send_to(datagram(0, 0), to));  // empty datagrams are datagrams too
 
-  DatagramBatch batch(8, 64);
+  transport::DatagramBatch batch(8, 64);
   ASSERT_EQ(receive(batch), 3U);
   ASSERT_EQ(batch.size(), 3U);
   EXPECT_EQ(batch[0].size, 10U);
@@ -81,10 +81,10 @@ TEST_F(ReceiveBatch, TakesSeveralDatagramsInOneCallInOrderWithTheirSenders) {
 }
 
 TEST_F(ReceiveBatch, StopsAtCapacityAndLeavesTheRestQueued) {
-  const Endpoint to = receiver_.local_endpoint();
+  const transport::Endpoint to = receiver_.local_endpoint();
   for (std::uint8_t i = 0; i < 5; ++i) ASSERT_TRUE(sender_a_.send_to(datagram(4, i), to));
 
-  DatagramBatch batch(2, 16);
+  transport::DatagramBatch batch(2, 16);
   std::vector<std::uint8_t> firsts;
   for (std::size_t expected : {2U, 2U, 1U}) {
     ASSERT_EQ(receive(batch), expected);
@@ -94,12 +94,12 @@ TEST_F(ReceiveBatch, StopsAtCapacityAndLeavesTheRestQueued) {
 }
 
 TEST_F(ReceiveBatch, AnOversizeDatagramKeepsItsRealSizeAndIsMarkedTruncated) {
-  const Endpoint to = receiver_.local_endpoint();
+  const transport::Endpoint to = receiver_.local_endpoint();
   ASSERT_TRUE(sender_a_.send_to(datagram(100, 0), to));
   ASSERT_TRUE(sender_a_.send_to(datagram(3000, 7), to));
   ASSERT_TRUE(sender_a_.send_to(datagram(100, 9), to));  // exactly the buffer: not truncated
 
-  DatagramBatch batch(4, 100);
+  transport::DatagramBatch batch(4, 100);
   ASSERT_EQ(receive(batch), 3U);
   EXPECT_FALSE(batch[0].truncated);
   EXPECT_TRUE(batch[1].truncated);
@@ -112,7 +112,7 @@ TEST_F(ReceiveBatch, AnOversizeDatagramKeepsItsRealSizeAndIsMarkedTruncated) {
 }
 
 TEST_F(ReceiveBatch, AnEmptySocketGivesNothingAtOnce) {
-  DatagramBatch batch(4, 64);
+  transport::DatagramBatch batch(4, 64);
   const auto start = std::chrono::steady_clock::now();
   EXPECT_EQ(receiver_.receive_batch(batch), 0U);
   EXPECT_TRUE(batch.empty());
@@ -121,16 +121,16 @@ TEST_F(ReceiveBatch, AnEmptySocketGivesNothingAtOnce) {
 }
 
 TEST_F(ReceiveBatch, ReceivesFromIpv6Senders) {
-  std::optional<UdpSocket> bound;
+  std::optional<transport::UdpSocket> bound;
   try {
-    bound.emplace(UdpSocket::bind(Endpoint::parse("[::1]:0")));
+    bound.emplace(transport::UdpSocket::bind(transport::Endpoint::parse("[::1]:0")));
   } catch (const std::system_error& error) {
     GTEST_SKIP() << "no IPv6 loopback here: " << error.what();
   }
-  UdpSocket& receiver = *bound;
-  UdpSocket sender = UdpSocket::bind(Endpoint::parse("[::1]:0"));
+  transport::UdpSocket& receiver = *bound;
+  transport::UdpSocket sender = transport::UdpSocket::bind(transport::Endpoint::parse("[::1]:0"));
   ASSERT_TRUE(sender.send_to(datagram(5, 0), receiver.local_endpoint()));
-  DatagramBatch batch(2, 8);
+  transport::DatagramBatch batch(2, 8);
   ASSERT_TRUE(receiver.wait_readable(1000ms));
   ASSERT_EQ(receiver.receive_batch(batch), 1U);
   EXPECT_EQ(batch[0].from, sender.local_endpoint());
@@ -138,9 +138,10 @@ TEST_F(ReceiveBatch, ReceivesFromIpv6Senders) {
 }
 
 TEST(UdpSocket, BindFailureNamesTheAddress) {
-  UdpSocket first = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
+  transport::UdpSocket first = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
   try {
-    UdpSocket::bind(Endpoint::parse("192.0.2.1:1"));  // TEST-NET-1: not an address of this host
+    transport::UdpSocket::bind(
+        transport::Endpoint::parse("192.0.2.1:1"));  // TEST-NET-1: not an address of this host
     FAIL() << "bind to a foreign address succeeded";
   } catch (const std::system_error& error) {
     EXPECT_NE(std::string(error.what()).find("192.0.2.1:1"), std::string::npos) << error.what();
@@ -149,14 +150,14 @@ TEST(UdpSocket, BindFailureNamesTheAddress) {
 
 TEST(UdpSocket, ASecondBindOfTheSamePortFails) {
   // Two gateways on one port would each get part of the stream; the second must fail loudly.
-  UdpSocket first = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
-  EXPECT_THROW(UdpSocket::bind(first.local_endpoint()), std::system_error);
+  transport::UdpSocket first = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
+  EXPECT_THROW(transport::UdpSocket::bind(first.local_endpoint()), std::system_error);
 }
 
 TEST(UdpSocket, MovesOwnershipOfTheDescriptor) {
-  UdpSocket a = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
+  transport::UdpSocket a = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
   const int fd = a.fd();
-  UdpSocket b = std::move(a);
+  transport::UdpSocket b = std::move(a);
   EXPECT_EQ(b.fd(), fd);
   EXPECT_EQ(a.fd(), -1);  // NOLINT(bugprone-use-after-move): the moved-from state is the contract
 }

@@ -25,7 +25,8 @@ inline std::vector<Vector> load_vectors(const std::string& file, const char* key
     if (line.empty()) continue;
     const auto json = nlohmann::json::parse(line);
     Vector vector;
-    if (!from_hex(json.at("frame_hex").get<std::string>(), vector.frame)) throw std::runtime_error("bad hex");
+    if (!wire::from_hex(json.at("frame_hex").get<std::string>(), vector.frame))
+      throw std::runtime_error("bad hex");
     vector.expected = json.at(key);
     vector.decoded_text = vector.expected.dump();
     vectors.push_back(std::move(vector));

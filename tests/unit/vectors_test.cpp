@@ -22,30 +22,30 @@ TEST(Vectors, AreAllThere) {
 TEST(Vectors, ValidFramesDecodeToTheExpectedValues) {
   for (const auto& vector : test::valid_vectors()) {
     SCOPED_TRACE(vector.decoded_text.substr(0, 120));
-    const DecodeResult result = decode(vector.frame);
+    const wire::DecodeResult result = wire::decode(vector.frame);
     ASSERT_TRUE(result) << result.error().message();
-    StateValues decoded;
+    wire::StateValues decoded;
     decoded.assign(result.frame());
 
-    StateValues expected;
+    wire::StateValues expected;
     std::string error;
-    ASSERT_TRUE(parse_canonical_json(vector.decoded_text, expected, error)) << error;
+    ASSERT_TRUE(wire::parse_canonical_json(vector.decoded_text, expected, error)) << error;
     EXPECT_EQ(decoded, expected);  // bit-exact, so -0.0 keeps its sign
 
     // Our JSON says the same, compared by value as the spec asks.
-    EXPECT_EQ(nlohmann::json::parse(to_canonical_json(decoded)), vector.expected);
+    EXPECT_EQ(nlohmann::json::parse(wire::to_canonical_json(decoded)), vector.expected);
   }
 }
 
 TEST(Vectors, ValidFramesEncodeByteForByte) {
   for (const auto& vector : test::valid_vectors()) {
     SCOPED_TRACE(vector.decoded_text.substr(0, 120));
-    StateValues values;
+    wire::StateValues values;
     std::string error;
-    ASSERT_TRUE(parse_canonical_json(vector.decoded_text, values, error)) << error;
-    std::array<std::uint8_t, kMaxFrameBytes> out{};
-    const EncodeResult result =
-        encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), out);
+    ASSERT_TRUE(wire::parse_canonical_json(vector.decoded_text, values, error)) << error;
+    std::array<std::uint8_t, wire::kMaxFrameBytes> out{};
+    const wire::EncodeResult result =
+        encode(values.packet_number, values.selection, values.storage(), wire::StateValues::layout(), out);
     ASSERT_TRUE(result) << result.error.message();
     EXPECT_EQ(std::vector<std::uint8_t>(out.begin(), out.begin() + static_cast<long>(result.size)),
               vector.frame);
@@ -54,41 +54,41 @@ TEST(Vectors, ValidFramesEncodeByteForByte) {
 
 TEST(Vectors, InvalidFramesFailWithTheSpecCategory) {
   for (const auto& vector : test::invalid_vectors()) {
-    const auto expected = parse_error_category(vector.expected.get<std::string>());
+    const auto expected = wire::parse_error_category(vector.expected.get<std::string>());
     ASSERT_TRUE(expected.has_value());
-    const DecodeResult result = decode(vector.frame);
+    const wire::DecodeResult result = wire::decode(vector.frame);
     ASSERT_FALSE(result);
     EXPECT_EQ(result.error().category(), *expected)
-        << "got " << to_string(result.error().category()) << ": " << result.error().message();
+        << "got " << wire::to_string(result.error().category()) << ": " << result.error().message();
     EXPECT_FALSE(result.error().message().empty());
   }
 }
 
 // The stitched decoder, one codec for all vectors so that its plan follows the selections.
 TEST(Vectors, ValidFramesDecodeThroughFrameCodec) {
-  FrameCodec codec(StateValues::layout());
+  wire::FrameCodec codec(wire::StateValues::layout());
   for (const auto& vector : test::valid_vectors()) {
     SCOPED_TRACE(vector.decoded_text.substr(0, 120));
-    StateValues decoded;
-    std::memset(decoded.storage(), 0xA5, StateValues::storage_size());  // stale values must not survive
-    const DecodeResult result = codec.decode(vector.frame, decoded.storage());
+    wire::StateValues decoded;
+    std::memset(decoded.storage(), 0xA5, wire::StateValues::storage_size());  // stale values must not survive
+    const wire::DecodeResult result = codec.decode(vector.frame, decoded.storage());
     ASSERT_TRUE(result) << result.error().message();
     decoded.packet_number = result.frame().packet_number();
     decoded.selection = result.frame().selection();
-    StateValues expected;
+    wire::StateValues expected;
     std::string error;
-    ASSERT_TRUE(parse_canonical_json(vector.decoded_text, expected, error)) << error;
+    ASSERT_TRUE(wire::parse_canonical_json(vector.decoded_text, expected, error)) << error;
     EXPECT_EQ(decoded, expected);
   }
 }
 
 TEST(Vectors, InvalidFramesFailThroughFrameCodecWithTheSpecCategory) {
-  FrameCodec codec(StateValues::layout());
+  wire::FrameCodec codec(wire::StateValues::layout());
   for (const auto& vector : test::invalid_vectors()) {
-    const auto expected = parse_error_category(vector.expected.get<std::string>());
+    const auto expected = wire::parse_error_category(vector.expected.get<std::string>());
     ASSERT_TRUE(expected.has_value());
-    StateValues values;
-    const DecodeResult result = codec.decode(vector.frame, values.storage());
+    wire::StateValues values;
+    const wire::DecodeResult result = codec.decode(vector.frame, values.storage());
     ASSERT_FALSE(result);
     EXPECT_EQ(result.error().category(), *expected) << result.error().message();
   }
@@ -96,7 +96,7 @@ TEST(Vectors, InvalidFramesFailThroughFrameCodecWithTheSpecCategory) {
 
 TEST(Crc32, MatchesTheZlibCheckValue) {
   const std::string check = "123456789";
-  EXPECT_EQ(crc32({reinterpret_cast<const std::uint8_t*>(check.data()), check.size()}), 0xCBF43926U);
+  EXPECT_EQ(wire::crc32({reinterpret_cast<const std::uint8_t*>(check.data()), check.size()}), 0xCBF43926U);
 }
 
 }  // namespace

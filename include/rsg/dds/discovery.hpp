@@ -3,9 +3,9 @@
 // (`--discovery-server`, `--peer`; src/tools/discovery_cli.hpp) and applies them to the QoS of
 // its participant profile:
 //
-//   rsg::DiscoveryOptions discovery;
+//   rsg::dds::DiscoveryOptions discovery;
 //   discovery.servers = {"198.18.0.2:11811"};
-//   rsg::Participant participant(domain, "rsg_participant", discovery);
+//   rsg::dds::Participant participant(domain, "rsg_participant", discovery);
 //
 // A server given as HOST:PORT is the one `fastdds discovery -i N -l HOST -p PORT` runs, where N
 // is its position in the list (0 for the first), as with ROS_DISCOVERY_SERVER; `N@HOST:PORT`
@@ -19,7 +19,7 @@
 
 #include "rsg/transport/host_port.hpp"  // check_discovery_server, check_peer, kGatewayParticipantIds
 
-namespace rsg {
+namespace rsg::dds {
 
 struct DiscoveryOptions {
   /// Discovery Servers, "[ID@]HOST:PORT": the participant becomes their CLIENT and sends no
@@ -42,4 +42,4 @@ struct DiscoveryOptions {
 void apply_discovery(const DiscoveryOptions& options, int domain,
                      eprosima::fastdds::dds::DomainParticipantQos& qos);
 
-}  // namespace rsg
+}  // namespace rsg::dds

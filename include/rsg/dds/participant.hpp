@@ -1,6 +1,6 @@
 // A DDS domain participant that owns every entity created through it.
 //
-//   rsg::Participant participant(domain, "rsg_participant");
+//   rsg::dds::Participant participant(domain, "rsg_participant");
 //   auto* topic = participant.robot_state_topic("robot_state");
 //   auto* writer = participant.publisher({"robot1"})->create_datawriter_with_profile(topic,
 //   "rsg_state_writer");
@@ -19,9 +19,7 @@
 
 #include "rsg/dds/discovery.hpp"
 
-namespace rsg {
-
-namespace fdds = eprosima::fastdds::dds;
+namespace rsg::dds {
 
 class Participant {
  public:
@@ -33,28 +31,29 @@ class Participant {
   /// Throws std::invalid_argument for a bad server or peer.
   Participant(int domain, const std::string& profile, const DiscoveryOptions& discovery);
   /// Creates the participant from explicit QoS.
-  Participant(int domain, const fdds::DomainParticipantQos& qos);
+  Participant(int domain, const eprosima::fastdds::dds::DomainParticipantQos& qos);
   ~Participant();
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;
 
-  fdds::DomainParticipant* get() const { return participant_; }
+  eprosima::fastdds::dds::DomainParticipant* get() const { return participant_; }
 
   /// Registers `RobotState` (with its type object, which content filters need) and returns the
   /// topic of that name, creating it once. Type information is not sent in discovery: Cyclone DDS
   /// 0.10 silently drops samples of writers that announce it.
   /// A non-empty `type_name` registers the same type under that name instead (e.g. the ROS 2 name
-  /// rsg::kRos2RobotStateType): same plain type, same loans, and content filters still find it.
-  fdds::Topic* robot_state_topic(const std::string& name, const std::string& type_name = {});
+  /// rsg::dds::kRos2RobotStateType): same plain type, same loans, and content filters still find it.
+  eprosima::fastdds::dds::Topic* robot_state_topic(const std::string& name,
+                                                   const std::string& type_name = {});
   /// Same for any other generated type (e.g. GatewayStatus); `type` is taken on first use.
-  fdds::Topic* topic(const std::string& name, fdds::TypeSupport type);
+  eprosima::fastdds::dds::Topic* topic(const std::string& name, eprosima::fastdds::dds::TypeSupport type);
 
   /// A publisher / subscriber in the given partitions (empty: the default partition).
-  fdds::Publisher* publisher(const std::vector<std::string>& partitions = {});
-  fdds::Subscriber* subscriber(const std::vector<std::string>& partitions = {});
+  eprosima::fastdds::dds::Publisher* publisher(const std::vector<std::string>& partitions = {});
+  eprosima::fastdds::dds::Subscriber* subscriber(const std::vector<std::string>& partitions = {});
 
  private:
-  fdds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
 };
 
-}  // namespace rsg
+}  // namespace rsg::dds

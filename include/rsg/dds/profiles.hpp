@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace rsg {
+namespace rsg::dds {
 
 /// The directory of the project's XML profiles: $RSG_PROFILES_DIR if set, else `xml_profiles/`
 /// or `share/rsg/xml_profiles/` found relative to the running binary, else the source tree.
@@ -20,4 +20,4 @@ void load_profiles(const std::filesystem::path& file_or_dir);
 /// Throws std::runtime_error naming the rejected file or the unknown profile.
 void load_profiles(const std::vector<std::string>& files_or_dirs, const std::string& participant_profile);
 
-}  // namespace rsg
+}  // namespace rsg::dds

@@ -9,7 +9,7 @@
 #include <string>
 #include <string_view>
 
-namespace rsg {
+namespace rsg::dds {
 
 inline constexpr std::string_view kRos2RobotStateType = "rsg_msgs::msg::dds_::RobotState_";
 inline constexpr std::string_view kRos2GatewayStatusType = "rsg_msgs::msg::dds_::GatewayStatus_";
@@ -51,4 +51,4 @@ inline std::string ros2_topic_name(std::string_view ns, std::string_view name) {
   return topic;
 }
 
-}  // namespace rsg
+}  // namespace rsg::dds

@@ -9,10 +9,10 @@
 // xml_profiles/views.xml and combines it with a reader QoS profile (`reader_realtime`,
 // `reader_logger`):
 //
-//   rsg::Participant participant(domain, "rsg_participant");
+//   rsg::dds::Participant participant(domain, "rsg_participant");
 //   auto* topic = participant.robot_state_topic("robot_state");
-//   rsg::ViewReader joints(*participant.subscriber({"robot1"}), *topic, "view_joints",
-//                          rsg::kRealtimeReaderProfile, &listener);
+//   rsg::dds::ViewReader joints(*participant.subscriber({"robot1"}), *topic, "view_joints",
+//                          rsg::dds::kRealtimeReaderProfile, &listener);
 //
 // Fast DDS evaluates the filter in the writer for remote UDP readers, so samples a view rejects
 // never cross the network; for data-sharing and intra-process readers it evaluates it in the reader.
@@ -28,9 +28,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace rsg {
-
-namespace fdds = eprosima::fastdds::dds;
+namespace rsg::dds {
 
 /// Property of a view profile: comma-separated group numbers that must all be present.
 inline constexpr const char* kViewGroupsProperty = "rsg.view.groups";
@@ -66,13 +64,14 @@ View group_view(std::uint8_t groups);
 
 /// The view a reader profile's properties describe (`profile` only names it in errors).
 /// Throws ViewError when it has neither or both of the view properties, or a bad group list.
-View parse_view(const std::string& profile, const fdds::DataReaderQos& qos);
+View parse_view(const std::string& profile, const eprosima::fastdds::dds::DataReaderQos& qos);
 
 /// Reads the view from an XML data_reader profile (load_profiles first). Throws ViewError.
-View load_view(const fdds::Subscriber& subscriber, const std::string& profile);
+View load_view(const eprosima::fastdds::dds::Subscriber& subscriber, const std::string& profile);
 
 /// Reads an XML data_reader profile's QoS. Throws ViewError naming an unknown profile.
-fdds::DataReaderQos load_reader_qos(const fdds::Subscriber& subscriber, const std::string& profile);
+eprosima::fastdds::dds::DataReaderQos load_reader_qos(const eprosima::fastdds::dds::Subscriber& subscriber,
+                                                      const std::string& profile);
 
 /// A DataReader on a view of a RobotState topic, deleted with this object.
 ///
@@ -84,28 +83,30 @@ class ViewReader {
   /// A reader on the view `view_profile` with the QoS of `qos_profile`; an empty `qos_profile`
   /// keeps the view profile's own QoS. Throws ViewError for unusable profiles and
   /// std::runtime_error when Fast DDS refuses an entity.
-  ViewReader(fdds::Subscriber& subscriber, fdds::Topic& topic, const std::string& view_profile,
-             const std::string& qos_profile, fdds::DataReaderListener* listener = nullptr,
-             const fdds::StatusMask& mask = fdds::StatusMask::all());
+  ViewReader(eprosima::fastdds::dds::Subscriber& subscriber, eprosima::fastdds::dds::Topic& topic,
+             const std::string& view_profile, const std::string& qos_profile,
+             eprosima::fastdds::dds::DataReaderListener* listener = nullptr,
+             const eprosima::fastdds::dds::StatusMask& mask = eprosima::fastdds::dds::StatusMask::all());
   /// A reader on an explicit view (e.g. group_view) with the given QoS.
-  ViewReader(fdds::Subscriber& subscriber, fdds::Topic& topic, View view, const fdds::DataReaderQos& qos,
-             fdds::DataReaderListener* listener = nullptr,
-             const fdds::StatusMask& mask = fdds::StatusMask::all());
+  ViewReader(eprosima::fastdds::dds::Subscriber& subscriber, eprosima::fastdds::dds::Topic& topic, View view,
+             const eprosima::fastdds::dds::DataReaderQos& qos,
+             eprosima::fastdds::dds::DataReaderListener* listener = nullptr,
+             const eprosima::fastdds::dds::StatusMask& mask = eprosima::fastdds::dds::StatusMask::all());
   ~ViewReader();
   ViewReader(const ViewReader&) = delete;
   ViewReader& operator=(const ViewReader&) = delete;
 
-  fdds::DataReader* get() const { return reader_; }
-  fdds::DataReader* operator->() const { return reader_; }
+  eprosima::fastdds::dds::DataReader* get() const { return reader_; }
+  eprosima::fastdds::dds::DataReader* operator->() const { return reader_; }
   const View& view() const { return view_; }
   /// The filtered topic the reader reads, "<topic>/<view name>".
-  fdds::ContentFilteredTopic* filtered_topic() const { return filtered_topic_; }
+  eprosima::fastdds::dds::ContentFilteredTopic* filtered_topic() const { return filtered_topic_; }
 
  private:
-  fdds::Subscriber& subscriber_;
+  eprosima::fastdds::dds::Subscriber& subscriber_;
   View view_;
-  fdds::ContentFilteredTopic* filtered_topic_ = nullptr;
-  fdds::DataReader* reader_ = nullptr;
+  eprosima::fastdds::dds::ContentFilteredTopic* filtered_topic_ = nullptr;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
 };
 
-}  // namespace rsg
+}  // namespace rsg::dds

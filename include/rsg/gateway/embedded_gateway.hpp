@@ -2,7 +2,7 @@
 // a callback on the ingress thread, with no socket and no DDS hop in between, while the same
 // samples are still published on DDS for everyone else (views, status, recorders unchanged).
 //
-//   rsg::EmbeddedGateway gateway(R"(
+//   rsg::gateway::EmbeddedGateway gateway(R"(
 //     listen: 0.0.0.0:5000
 //     domain: 3
 //   )", [&](const rsg::RobotState& state) { controller.update(state); });
@@ -29,7 +29,7 @@
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/transport/udp_socket.hpp"
 
-namespace rsg {
+namespace rsg::gateway {
 
 class EmbeddedGateway {
  public:
@@ -49,7 +49,7 @@ class EmbeddedGateway {
 
   /// Where frames are received (with `listen: HOST:0`, the port the kernel picked). Throws
   /// std::logic_error after stop().
-  Endpoint local_endpoint() const;
+  transport::Endpoint local_endpoint() const;
 
   /// Ends the ingress thread (within 100 ms), publishes the final status, deletes the DDS
   /// entities and closes the socket. No callback runs once it returns. Idempotent; never from
@@ -61,4 +61,4 @@ class EmbeddedGateway {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace rsg
+}  // namespace rsg::gateway

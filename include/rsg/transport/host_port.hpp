@@ -10,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-namespace rsg {
+namespace rsg::transport {
 
 /// A HOST:PORT split in two; `host` keeps IPv6 brackets ("[::1]").
 struct HostPort {
@@ -53,4 +53,4 @@ inline constexpr std::string_view kPeerHelp =
     "Send discovery announcements to this unicast peer instead of multicast, HOST[:PORT] "
     "(repeatable; HOST alone covers participant ids 0..59)";
 
-}  // namespace rsg
+}  // namespace rsg::transport

@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-namespace rsg {
+namespace rsg::transport {
 
 /// An IPv4 or IPv6 address and port.
 class Endpoint {
@@ -118,4 +118,4 @@ class UdpSocket {
   int fd_ = -1;
 };
 
-}  // namespace rsg
+}  // namespace rsg::transport

@@ -9,7 +9,7 @@
 
 #include "rsg/wire/frame.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 /// Accumulates bytes and hands out every span that is a CRC-correct frame. Bytes that cannot start
 /// one are skipped one at a time and counted, so the stream resynchronises after garbage. A frame
@@ -64,4 +64,4 @@ class Deframer {
   std::uint64_t skipped_bytes_ = 0;
 };
 
-}  // namespace rsg
+}  // namespace rsg::wire

@@ -7,7 +7,7 @@
 #include <optional>
 #include <string_view>
 
-namespace rsg {
+namespace rsg::wire {
 
 /// The spec's error categories, in the order its validation checks them.
 enum class ErrorCategory : std::uint8_t {
@@ -55,4 +55,4 @@ class FrameError {
   std::array<char, 112> message_;  // NUL-terminated
 };
 
-}  // namespace rsg
+}  // namespace rsg::wire

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string_view>
 
-namespace rsg {
+namespace rsg::wire {
 
 inline constexpr std::size_t kErrorFlagCount = 37;
 /// Bits 37..39 of the 40-bit error set are reserved and make a frame invalid.
@@ -55,4 +55,4 @@ inline constexpr std::uint8_t kMaxRobotMode = 6;
 inline constexpr std::array<std::string_view, kMaxRobotMode + 1> kRobotModeNames = {
     "other", "idle", "move", "guiding", "reflex", "user_stopped", "automatic_error_recovery"};
 
-}  // namespace rsg
+}  // namespace rsg::wire

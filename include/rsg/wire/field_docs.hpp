@@ -9,7 +9,7 @@
 
 #include "rsg/wire/field_table.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 struct FieldDoc {
   /// One unit for every element, or one per element separated by commas ("N,N,N,Nm,Nm,Nm").
@@ -116,4 +116,4 @@ constexpr FieldDoc field_doc(Field field) {
   return {};
 }
 
-}  // namespace rsg
+}  // namespace rsg::wire

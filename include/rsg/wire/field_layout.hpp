@@ -8,7 +8,7 @@
 
 #include "rsg/wire/field_table.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 /// Byte offset of each field's value (host representation, `FieldInfo::value_bytes()` long)
 /// from the start of the struct that holds it.
@@ -23,4 +23,4 @@ struct FieldLayout {
   }
 };
 
-}  // namespace rsg
+}  // namespace rsg::wire

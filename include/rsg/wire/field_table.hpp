@@ -13,7 +13,7 @@
 #include <optional>
 #include <string_view>
 
-namespace rsg {
+namespace rsg::wire {
 
 /// How one element of a field is stored on the wire.
 enum class ElementType : std::uint8_t {
@@ -172,4 +172,4 @@ static_assert(kMaxDataBytes == 2123, "docs/protocol.md: a full frame carries 212
 static_assert(kGroupBytes == std::array<std::uint16_t, kGroupCount>{624, 248, 368, 424, 437, 22});
 static_assert(kFullFrameOffsets[static_cast<std::size_t>(Field::time)] == 2125);
 
-}  // namespace rsg
+}  // namespace rsg::wire

@@ -1,8 +1,8 @@
 // Decoding and encoding SEND_BUF frames (docs/protocol.md). No allocation, no DDS.
 //
-//   auto result = rsg::decode(bytes);
+//   auto result = rsg::wire::decode(bytes);
 //   if (!result) { count(result.error().category()); return; }
-//   rsg::copy_fields(result.frame(), &sample, layout);
+//   rsg::wire::copy_fields(result.frame(), &sample, layout);
 //
 // A stream decoded into structs frame after frame is faster through `FrameCodec`
 // (rsg/wire/frame_codec.hpp), which copies during the CRC pass.
@@ -18,7 +18,7 @@
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/selection.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 inline constexpr std::size_t kHeaderBytes = 10;
 inline constexpr std::size_t kCrcBytes = 4;
@@ -103,4 +103,4 @@ struct SelectionRequestResult {
 /// Reads a selection request as a robot would.
 SelectionRequestResult decode_selection_request(std::span<const std::uint8_t> bytes) noexcept;
 
-}  // namespace rsg
+}  // namespace rsg::wire

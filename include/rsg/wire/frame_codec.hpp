@@ -1,7 +1,7 @@
 // Decoding frames straight into a struct, and encoding them from one, in one pass over the payload.
 //
-//   rsg::FrameCodec codec(rsg::robot_state_layout());   // one per stream; not thread-safe
-//   const rsg::DecodeResult result = codec.decode(datagram, &sample);
+//   rsg::wire::FrameCodec codec(rsg::dds::robot_state_layout());   // one per stream; not thread-safe
+//   const rsg::wire::DecodeResult result = codec.decode(datagram, &sample);
 //   if (!result) { count(result.error().category()); return; }   // `sample` holds garbage: drop it
 //
 // The same checks and results as `decode` followed by `copy_fields`, and `encode`, but the copy
@@ -17,19 +17,19 @@
 #include "rsg/wire/field_layout.hpp"
 #include "rsg/wire/frame.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 class FrameCodec {
  public:
   /// `layout` describes the struct this codec fills and reads; it must outlive the codec.
   explicit FrameCodec(const FieldLayout& layout) noexcept;
 
-  /// Validates `bytes` like `rsg::decode` and, as it goes, copies the fields into the struct at
+  /// Validates `bytes` like `rsg::wire::decode` and, as it goes, copies the fields into the struct at
   /// `base` and zeroes the fields the frame does not carry. On failure the struct's field bytes
   /// are unspecified (part of the rejected frame may have landed there): never publish them.
   DecodeResult decode(std::span<const std::uint8_t> bytes, void* base) noexcept;
 
-  /// `rsg::encode` with this codec's layout.
+  /// `rsg::wire::encode` with this codec's layout.
   EncodeResult encode(std::uint8_t packet_number, const Selection& selection, const void* base,
                       std::span<std::uint8_t> out) noexcept;
 
@@ -42,4 +42,4 @@ class FrameCodec {
   std::uint64_t plan_key_;  // plan_'s selection as 7 header bytes
 };
 
-}  // namespace rsg
+}  // namespace rsg::wire

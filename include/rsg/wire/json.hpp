@@ -6,7 +6,7 @@
 
 #include "rsg/wire/state_values.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 /// Appends `values` as one canonical JSON object (no newline). Doubles use the shortest form that
 /// round-trips; NaN and infinities are the strings "nan", "inf", "-inf".
@@ -17,4 +17,4 @@ std::string to_canonical_json(const StateValues& values);
 /// JSON, unknown fields, wrong shapes or values out of range; `fields` must match the selection.
 bool parse_canonical_json(std::string_view text, StateValues& out, std::string& error);
 
-}  // namespace rsg
+}  // namespace rsg::wire

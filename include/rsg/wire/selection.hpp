@@ -8,7 +8,7 @@
 
 #include "rsg/wire/field_table.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 struct Selection {
   std::uint8_t group_select = 0;
@@ -54,4 +54,4 @@ bool parse_group_list(std::string_view list, Selection& out, std::string& error)
 /// Parses a group list into a group_select bit mask.
 bool parse_group_mask(std::string_view list, std::uint8_t& out, std::string& error);
 
-}  // namespace rsg
+}  // namespace rsg::wire

@@ -11,7 +11,7 @@
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/selection.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 class FrameView;
 
@@ -49,4 +49,4 @@ class StateValues {
   alignas(8) std::array<std::byte, kStorageBytes> storage_{};
 };
 
-}  // namespace rsg
+}  // namespace rsg::wire

@@ -6,7 +6,7 @@
 
 #include "rsg/wire/error_flags.hpp"
 
-namespace rsg::echo {
+namespace rsg::tools::echo {
 namespace {
 
 constexpr auto kRateWindow = std::chrono::seconds(1);
@@ -24,25 +24,26 @@ __attribute__((format(printf, 2, 3))) void append(std::string& out, const char* 
 }
 
 // One labelled line per key value; "-" when the last sample did not carry the field.
-void append_field_line(std::string& out, const StateValues& values, Field field) {
-  append(out, "%-11s", std::string(info(field).name).c_str());
+void append_field_line(std::string& out, const wire::StateValues& values, wire::Field field) {
+  append(out, "%-11s", std::string(wire::info(field).name).c_str());
   if (!values.selection.contains(field)) {
     out += "-\n";
     return;
   }
   switch (field) {
-    case Field::O_T_EE: {
+    case wire::Field::O_T_EE: {
       const auto pose = values.doubles(field);  // column-major 4x4: translation is column 3
       append(out, "x %+.5g  y %+.5g  z %+.5g m\n", pose[12], pose[13], pose[14]);
       return;
     }
-    case Field::robot_mode: {
+    case wire::Field::robot_mode: {
       const auto mode = values.integer(field);
-      append(out, "%s (%llu)\n", mode <= kMaxRobotMode ? std::string(kRobotModeNames[mode]).c_str() : "?",
+      append(out, "%s (%llu)\n",
+             mode <= wire::kMaxRobotMode ? std::string(wire::kRobotModeNames[mode]).c_str() : "?",
              static_cast<unsigned long long>(mode));
       return;
     }
-    case Field::time:
+    case wire::Field::time:
       append(out, "%llu ms\n", static_cast<unsigned long long>(values.integer(field)));
       return;
     default:
@@ -55,7 +56,7 @@ void append_field_line(std::string& out, const StateValues& values, Field field)
 
 }  // namespace
 
-void StreamStats::add(const StateValues& values, Clock::time_point now) {
+void StreamStats::add(const wire::StateValues& values, Clock::time_point now) {
   if (samples_ == 0) {
     window_start_ = now;
   } else {
@@ -78,7 +79,7 @@ std::string render_table(const std::string& header, const StreamStats& stats, Cl
     out += "waiting for samples\n";
     return out;
   }
-  const StateValues& last = stats.last();
+  const wire::StateValues& last = stats.last();
   append(out, "samples %llu  rate %.1f/s  packet-number gaps %llu  last %.1f ms ago\n",
          static_cast<unsigned long long>(stats.samples()), stats.rate(),
          static_cast<unsigned long long>(stats.packet_number_gaps()),
@@ -86,7 +87,8 @@ std::string render_table(const std::string& header, const StreamStats& stats, Cl
   append(out, "packet %u  group_select 0x%02x  data_select", last.packet_number, last.selection.group_select);
   for (const std::uint8_t byte : last.selection.data_select) append(out, " %02x", byte);
   out += '\n';
-  for (const Field field : {Field::q, Field::dq, Field::O_T_EE, Field::robot_mode, Field::time})
+  for (const wire::Field field :
+       {wire::Field::q, wire::Field::dq, wire::Field::O_T_EE, wire::Field::robot_mode, wire::Field::time})
     append_field_line(out, last, field);
   return out;
 }
@@ -100,4 +102,4 @@ void TerminalTable::draw(const std::string& table) {
   std::fflush(stdout);
 }
 
-}  // namespace rsg::echo
+}  // namespace rsg::tools::echo

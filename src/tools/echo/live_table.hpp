@@ -7,14 +7,14 @@
 
 #include "rsg/wire/state_values.hpp"
 
-namespace rsg::echo {
+namespace rsg::tools::echo {
 
 using Clock = std::chrono::steady_clock;
 
 /// What the table shows about the stream, fed one sample at a time.
 class StreamStats {
  public:
-  void add(const StateValues& values, Clock::time_point now);
+  void add(const wire::StateValues& values, Clock::time_point now);
 
   std::uint64_t samples() const { return samples_; }
   /// Packet numbers skipped between consecutive samples (mod 16). On a view this includes the
@@ -22,13 +22,13 @@ class StreamStats {
   std::uint64_t packet_number_gaps() const { return gaps_; }
   /// Samples per second over the last complete second.
   double rate() const { return rate_; }
-  const StateValues& last() const { return last_; }
+  const wire::StateValues& last() const { return last_; }
   Clock::time_point last_arrival() const { return last_arrival_; }
 
  private:
   std::uint64_t samples_ = 0;
   std::uint64_t gaps_ = 0;
-  StateValues last_;
+  wire::StateValues last_;
   Clock::time_point last_arrival_;
   Clock::time_point window_start_;
   std::uint64_t window_samples_ = 0;
@@ -49,4 +49,4 @@ class TerminalTable {
   int previous_lines_ = 0;
 };
 
-}  // namespace rsg::echo
+}  // namespace rsg::tools::echo

@@ -37,7 +37,7 @@
 namespace {
 
 namespace fdds = eprosima::fastdds::dds;
-using rsg::echo::Clock;
+using rsg::tools::echo::Clock;
 
 using namespace rsg::tools;  // exit statuses
 
@@ -56,9 +56,9 @@ struct Options {
   bool json = false;
   std::uint64_t count = 0;  // 0: no limit
   double timeout_seconds = 0;
-  std::vector<std::string> profiles;  // empty: rsg::default_profiles_dir()
+  std::vector<std::string> profiles;  // empty: rsg::dds::default_profiles_dir()
   std::string participant_profile = "rsg_participant";
-  rsg::DiscoveryOptions discovery;
+  rsg::dds::DiscoveryOptions discovery;
 };
 
 using rsg::tools::StopOnSignal;
@@ -87,9 +87,9 @@ class SampleSink {
  public:
   SampleSink(bool json, std::string header) : json_(json), header_(std::move(header)) {}
 
-  void add(const rsg::StateValues& values, Clock::time_point now) {
+  void add(const rsg::wire::StateValues& values, Clock::time_point now) {
     if (json_) {
-      rsg::append_canonical_json(values, pending_);
+      rsg::wire::append_canonical_json(values, pending_);
       pending_ += '\n';
     } else {
       stats_.add(values, now);
@@ -107,7 +107,7 @@ class SampleSink {
     }
     if (!force_table && now < next_draw_) return;
     next_draw_ = now + kRefreshPeriod;
-    const std::string table = rsg::echo::render_table(header_, stats_, now);
+    const std::string table = rsg::tools::echo::render_table(header_, stats_, now);
     if (interactive_) {
       terminal_.draw(table);
     } else if (force_table || now >= next_log_) {  // a log file gets one table a second
@@ -121,8 +121,8 @@ class SampleSink {
   bool json_;
   std::string header_;
   std::string pending_;
-  rsg::echo::StreamStats stats_;
-  rsg::echo::TerminalTable terminal_;
+  rsg::tools::echo::StreamStats stats_;
+  rsg::tools::echo::TerminalTable terminal_;
   bool interactive_ = ::isatty(STDOUT_FILENO) != 0;
   Clock::time_point next_draw_;
   Clock::time_point next_log_;
@@ -138,7 +138,7 @@ void add_options(CLI::App& app, Options& options) {
       "--ros2", options.ros2,
       "Read what rsg_gateway --ros2 writes: topic rt/<ns>/<topic>, type rsg_msgs::msg::dds_::RobotState_");
   app.add_option("--ros2-namespace", options.ros2_namespace, "ROS 2 namespace with --ros2, e.g. /robot1")
-      ->check([](const std::string& ns) { return rsg::check_ros2_namespace(ns); });
+      ->check([](const std::string& ns) { return rsg::dds::check_ros2_namespace(ns); });
   auto* view = app.add_option("--view", options.view_profile,
                               "View profile, e.g. view_joints: only samples carrying its groups");
   auto* groups = app.add_option("--groups", options.groups,
@@ -157,37 +157,38 @@ void add_options(CLI::App& app, Options& options) {
   app.add_option("--profiles", options.profiles,
                  "XML profile file or directory; repeat to load several (e.g. rsg's profiles and a secure "
                  "participant profile)")
-      ->default_str(rsg::default_profiles_dir().string());
+      ->default_str(rsg::dds::default_profiles_dir().string());
   app.add_option("--participant-profile", options.participant_profile,
                  "XML participant profile, e.g. rsg_secure_reader under DDS Security")
       ->capture_default_str();
-  rsg::add_discovery_options(app, options.discovery);
+  rsg::tools::add_discovery_options(app, options.discovery);
 }
 
 /// What the reader reads: a view, or the whole topic.
-std::optional<rsg::View> requested_view(const Options& options, const fdds::Subscriber& subscriber) {
-  if (!options.view_profile.empty()) return rsg::load_view(subscriber, options.view_profile);
+std::optional<rsg::dds::View> requested_view(const Options& options, const fdds::Subscriber& subscriber) {
+  if (!options.view_profile.empty()) return rsg::dds::load_view(subscriber, options.view_profile);
   if (options.groups.empty()) return std::nullopt;
   std::uint8_t mask = 0;
   std::string error;
-  if (!rsg::parse_group_mask(options.groups, mask, error)) throw rsg::ViewError("--groups: " + error);
-  return rsg::group_view(mask);
+  if (!rsg::wire::parse_group_mask(options.groups, mask, error))
+    throw rsg::dds::ViewError("--groups: " + error);
+  return rsg::dds::group_view(mask);
 }
 
 int run(const Options& options) {
   StopOnSignal::block_stop_signals();
-  rsg::Participant participant(options.domain, options.participant_profile, options.discovery);
+  rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery);
   const std::string topic_name =
-      options.ros2 ? rsg::ros2_topic_name(options.ros2_namespace, options.topic) : options.topic;
-  fdds::Topic& topic =
-      *participant.robot_state_topic(topic_name, options.ros2 ? std::string(rsg::kRos2RobotStateType) : "");
+      options.ros2 ? rsg::dds::ros2_topic_name(options.ros2_namespace, options.topic) : options.topic;
+  fdds::Topic& topic = *participant.robot_state_topic(
+      topic_name, options.ros2 ? std::string(rsg::dds::kRos2RobotStateType) : "");
   fdds::Subscriber& subscriber = *participant.subscriber(options.partitions);
 
   const std::string qos_profile = !options.qos_profile.empty() ? options.qos_profile
-                                  : options.json               ? rsg::kLoggerReaderProfile
-                                                               : rsg::kRealtimeReaderProfile;
-  const fdds::DataReaderQos qos = rsg::load_reader_qos(subscriber, qos_profile);
-  std::optional<rsg::ViewReader> view_reader;
+                                  : options.json               ? rsg::dds::kLoggerReaderProfile
+                                                               : rsg::dds::kRealtimeReaderProfile;
+  const fdds::DataReaderQos qos = rsg::dds::load_reader_qos(subscriber, qos_profile);
+  std::optional<rsg::dds::ViewReader> view_reader;
   fdds::DataReader* reader = nullptr;  // owned by view_reader, or by the participant
   if (auto view = requested_view(options, subscriber)) {
     view_reader.emplace(subscriber, topic, std::move(*view), qos);
@@ -221,7 +222,7 @@ int run(const Options& options) {
   FASTDDS_SEQUENCE(RobotStateSeq, rsg::RobotState);
   RobotStateSeq samples;
   fdds::SampleInfoSeq infos;
-  rsg::StateValues values;
+  rsg::wire::StateValues values;
 
   while (true) {
     fdds::ConditionSeq triggered;
@@ -247,7 +248,7 @@ int run(const Options& options) {
     while (!done && reader->take(samples, infos) == ReturnCode_t::RETCODE_OK) {
       for (fdds::LoanableCollection::size_type i = 0; i < samples.length() && !done; ++i) {
         if (!infos[i].valid_data) continue;
-        rsg::to_values(samples[i], values);
+        rsg::dds::to_values(samples[i], values);
         // A data-sharing loan points into the writer's history, which the writer may have reused
         // for a newer sample before or while it was copied; such a copy is no sample at all.
         if (!reader->is_sample_valid(&samples[i], &infos[i])) continue;

@@ -15,7 +15,7 @@
 #include "rsg/wire/json.hpp"
 #include "rsg/wire/state_values.hpp"
 
-namespace rsg::frame_tool {
+namespace rsg::tools::frame {
 namespace {
 
 constexpr std::string_view kWhitespace = " \t\r\n\v\f";
@@ -58,7 +58,7 @@ std::string error_line(std::string_view category, std::string_view message) {
 
 void write_frame(std::ostream& out, std::span<const std::uint8_t> frame, FrameFormat format) {
   if (format == FrameFormat::kHexLines) {
-    out << to_hex(frame) << '\n';
+    out << wire::to_hex(frame) << '\n';
   } else {
     out.write(reinterpret_cast<const char*>(frame.data()), static_cast<std::streamsize>(frame.size()));
   }
@@ -84,36 +84,36 @@ int finish(Streams streams, int status) {
 int decode_binary(Streams streams) {
   const std::vector<std::uint8_t> bytes(std::istreambuf_iterator<char>(streams.in), {});
   if (streams.in.bad()) return finish(streams, kExitInvalid);
-  const DecodeResult result = decode(bytes);
+  const wire::DecodeResult result = wire::decode(bytes);
   if (!result) {
-    streams.err << "error: " << to_string(result.error().category()) << ": " << result.error().message()
+    streams.err << "error: " << wire::to_string(result.error().category()) << ": " << result.error().message()
                 << '\n';
     return finish(streams, kExitInvalid);
   }
-  StateValues values;
+  wire::StateValues values;
   values.assign(result.frame());
-  streams.out << to_canonical_json(values) << '\n';
+  streams.out << wire::to_canonical_json(values) << '\n';
   return finish(streams, kExitOk);
 }
 
 int decode_hex_lines(Streams streams) {
   std::vector<std::uint8_t> bytes;
-  StateValues values;
+  wire::StateValues values;
   std::string json;
   for_each_nonblank_line(streams.in, [&](std::size_t number, std::string_view text) {
-    if (!from_hex(text, bytes)) {
+    if (!wire::from_hex(text, bytes)) {
       streams.out << error_line("bad_hex", "line " + std::to_string(number) + ": " + describe_bad_hex(text))
                   << '\n';
       return true;
     }
-    const DecodeResult result = decode(bytes);
+    const wire::DecodeResult result = wire::decode(bytes);
     if (!result) {
-      streams.out << error_line(to_string(result.error().category()), result.error().message()) << '\n';
+      streams.out << error_line(wire::to_string(result.error().category()), result.error().message()) << '\n';
       return true;
     }
     values.assign(result.frame());
     json.clear();
-    append_canonical_json(values, json);
+    wire::append_canonical_json(values, json);
     streams.out << json << '\n';
     return true;
   });
@@ -122,20 +122,21 @@ int decode_hex_lines(Streams streams) {
 
 int encode_json_lines(Streams streams, FrameFormat format) {
   int status = kExitOk;
-  StateValues values;
+  wire::StateValues values;
   std::string reason;
-  std::array<std::uint8_t, kMaxFrameBytes> frame{};
+  std::array<std::uint8_t, wire::kMaxFrameBytes> frame{};
   for_each_nonblank_line(streams.in, [&](std::size_t number, std::string_view text) {
-    if (!parse_canonical_json(text, values, reason)) {
+    if (!wire::parse_canonical_json(text, values, reason)) {
       streams.err << "error: line " << number << ": " << reason << '\n';
       status = kExitInvalid;
       return false;
     }
-    const EncodeResult result =
-        encode(values.packet_number, values.selection, values.storage(), StateValues::layout(), frame);
+    const wire::EncodeResult result =
+        encode(values.packet_number, values.selection, values.storage(), wire::StateValues::layout(), frame);
     if (!result) {
-      streams.err << "error: line " << number << ": cannot encode: " << to_string(result.error.category())
-                  << ": " << result.error.message() << '\n';
+      streams.err << "error: line " << number
+                  << ": cannot encode: " << wire::to_string(result.error.category()) << ": "
+                  << result.error.message() << '\n';
       status = kExitInvalid;
       return false;
     }
@@ -145,16 +146,17 @@ int encode_json_lines(Streams streams, FrameFormat format) {
   return finish(streams, status);
 }
 
-int write_selection_request(Streams streams, std::uint8_t packet_number, const Selection& selection,
+int write_selection_request(Streams streams, std::uint8_t packet_number, const wire::Selection& selection,
                             FrameFormat format) {
-  std::array<std::uint8_t, kSelectionRequestBytes> frame{};
-  const EncodeResult result = encode_selection_request(packet_number, selection, frame);
+  std::array<std::uint8_t, wire::kSelectionRequestBytes> frame{};
+  const wire::EncodeResult result = encode_selection_request(packet_number, selection, frame);
   if (!result) {
-    streams.err << "error: " << to_string(result.error.category()) << ": " << result.error.message() << '\n';
+    streams.err << "error: " << wire::to_string(result.error.category()) << ": " << result.error.message()
+                << '\n';
     return finish(streams, kExitInvalid);
   }
   write_frame(streams.out, std::span(frame).first(result.size), format);
   return finish(streams, kExitOk);
 }
 
-}  // namespace rsg::frame_tool
+}  // namespace rsg::tools::frame

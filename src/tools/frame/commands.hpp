@@ -7,7 +7,7 @@
 
 #include "rsg/wire/selection.hpp"
 
-namespace rsg::frame_tool {
+namespace rsg::tools::frame {
 
 /// Process exit status, the same for every subcommand.
 enum ExitStatus : int {
@@ -38,7 +38,7 @@ int decode_hex_lines(Streams streams);
 int encode_json_lines(Streams streams, FrameFormat format);
 
 /// Writes the spec's selection request (gateway -> robot) for `selection`.
-int write_selection_request(Streams streams, std::uint8_t packet_number, const Selection& selection,
+int write_selection_request(Streams streams, std::uint8_t packet_number, const wire::Selection& selection,
                             FrameFormat format);
 
-}  // namespace rsg::frame_tool
+}  // namespace rsg::tools::frame

@@ -11,7 +11,7 @@
 
 namespace {
 
-using namespace rsg::frame_tool;
+using namespace rsg::tools::frame;
 
 /// The input a subcommand reads: the named file, or standard input for "-".
 class Input {
@@ -36,7 +36,7 @@ struct Options {
   std::string input = "-";
   bool hex_lines = false;
   unsigned packet_number = 0;
-  rsg::Selection selection;
+  rsg::wire::Selection selection;
 };
 
 void add_input(CLI::App& command, Options& options) {
@@ -53,9 +53,9 @@ void add_selection(CLI::App& command, Options& options) {
       if (!parse(list, options.selection, error)) throw CLI::ValidationError(option, error);
     };
   };
-  choice->add_option_function<std::string>("--groups", parse_into(rsg::parse_group_list, "--groups"),
+  choice->add_option_function<std::string>("--groups", parse_into(rsg::wire::parse_group_list, "--groups"),
                                            "Comma-separated group numbers 0..5, every field of each");
-  choice->add_option_function<std::string>("--fields", parse_into(rsg::parse_field_list, "--fields"),
+  choice->add_option_function<std::string>("--fields", parse_into(rsg::wire::parse_field_list, "--fields"),
                                            "Comma-separated field names of docs/protocol.md, e.g. q,dq,time");
   choice->require_option(1);
 }

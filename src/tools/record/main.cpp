@@ -58,7 +58,7 @@ std::uint64_t now_ns() {
 /// One MCAP file after another (with --split-size), each complete with its own schemas and channels.
 class Recording {
  public:
-  Recording(const Options& options, rsg::record::Profile profile)
+  Recording(const Options& options, rsg::tools::record::Profile profile)
       : options_(options),
         profile_(profile),
         split_bytes_(static_cast<std::uint64_t>(options.split_mb * 1e6)) {
@@ -131,12 +131,12 @@ class Recording {
 
   void open() {
     const fs::path path = next_path();
-    writer_.emplace(path,
-                    rsg::mcap::WriterOptions{.profile = std::string(rsg::record::header_profile(profile_)),
-                                             .library = "rsg_record",
-                                             .chunk_bytes = options_.chunk_bytes,
-                                             .sync = options_.fsync});
-    channels_ = rsg::record::add_channels(*writer_, profile_, options_.topic, options_.status_topic);
+    writer_.emplace(
+        path, rsg::mcap::WriterOptions{.profile = std::string(rsg::tools::record::header_profile(profile_)),
+                                       .library = "rsg_record",
+                                       .chunk_bytes = options_.chunk_bytes,
+                                       .sync = options_.fsync});
+    channels_ = rsg::tools::record::add_channels(*writer_, profile_, options_.topic, options_.status_topic);
     ++files;
     if (split_bytes_ != 0) std::cerr << "rsg_record: writing " << path.string() << "\n";
   }
@@ -187,11 +187,11 @@ class Recording {
   }
 
   const Options& options_;
-  rsg::record::Profile profile_;
+  rsg::tools::record::Profile profile_;
   std::uint64_t split_bytes_;
   std::optional<rsg::mcap::Writer> writer_;
-  rsg::record::Channels channels_;
-  rsg::record::CdrSerializer serializer_;
+  rsg::tools::record::Channels channels_;
+  rsg::tools::record::CdrSerializer serializer_;
   std::vector<Pending> batch_;
   std::vector<std::uint8_t> batch_bytes_;
   std::uint64_t last_log_time_ = 0;
@@ -264,11 +264,11 @@ int recover(const Options& options) {
   return kExitOk;
 }
 
-int run(const Options& options, rsg::record::Profile profile) {
+int run(const Options& options, rsg::tools::record::Profile profile) {
   StopOnSignal::block_stop_signals();
   Recording recording(options, profile);  // before DDS: an unwritable path fails at once
 
-  rsg::Participant participant(options.domain, options.participant_profile, options.discovery);
+  rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery);
   rsg::tools::MonitorReaders readers(participant, options.topics(), rsg::tools::WakeUp::kPeriodically);
   StopOnSignal stop_on_signal([&readers] { readers.request_stop(); });
 
@@ -347,17 +347,17 @@ int main(int argc, char** argv) {
     }
     return run_reporting_errors("rsg_record", [&] { return recover(options); });
   }
-  const auto profile = rsg::record::parse_profile(options.profile);
+  const auto profile = rsg::tools::record::parse_profile(options.profile);
   if (!profile) {
     std::cerr << "rsg_record: --profile must be omgidl or ros2, not '" << options.profile << "'\n";
     return kExitUsage;
   }
-  if (*profile == rsg::record::Profile::ros2 && !rsg::record::has_ros2_schemas()) {
+  if (*profile == rsg::tools::record::Profile::ros2 && !rsg::tools::record::has_ros2_schemas()) {
     std::cerr << "rsg_record: this build has no ros2/rsg_msgs/msg/RobotState.msg, so no --profile ros2\n";
     return kExitUsage;
   }
-  if (*profile == rsg::record::Profile::ros2 && !options.status_topic.empty() &&
-      !rsg::record::has_ros2_status_schema())
+  if (*profile == rsg::tools::record::Profile::ros2 && !options.status_topic.empty() &&
+      !rsg::tools::record::has_ros2_status_schema())
     std::cerr
         << "rsg_record: warning: this build has no ros2/rsg_msgs/msg/GatewayStatus.msg, so a --profile ros2 "
            "recording leaves '"

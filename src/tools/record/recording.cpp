@@ -9,7 +9,7 @@
 
 #include "recording_schemas.hpp"
 
-namespace rsg::record {
+namespace rsg::tools::record {
 namespace {
 
 std::span<const std::uint8_t> bytes_of(std::string_view text) {
@@ -121,4 +121,4 @@ bool CdrSerializer::deserialize(std::span<const std::uint8_t> bytes, RobotState&
   }
 }
 
-}  // namespace rsg::record
+}  // namespace rsg::tools::record

@@ -48,7 +48,7 @@ struct Options {
   std::string writer_profile = "rsg_state_writer";
   std::vector<std::string> profiles;
   std::string participant_profile = "rsg_participant";
-  rsg::DiscoveryOptions discovery;
+  rsg::dds::DiscoveryOptions discovery;
   int wait_for_readers = 0;
   double speed = 1;
   bool loop = false;
@@ -66,9 +66,10 @@ class Output {
 
 class UdpOutput final : public Output {
  public:
-  explicit UdpOutput(const rsg::Endpoint& to) : to_(to), socket_(rsg::UdpSocket::for_sending_to(to)) {}
+  explicit UdpOutput(const rsg::transport::Endpoint& to)
+      : to_(to), socket_(rsg::transport::UdpSocket::for_sending_to(to)) {}
   bool send(const rsg::RobotState& sample) override {
-    const rsg::EncodeResult frame = codec_.encode(sample, frame_);
+    const rsg::wire::EncodeResult frame = codec_.encode(sample, frame_);
     if (!frame) {
       ++unencodable;  // a sample no valid frame could have produced (written by another app)
       return true;
@@ -80,10 +81,10 @@ class UdpOutput final : public Output {
   std::uint64_t unencodable = 0;
 
  private:
-  rsg::Endpoint to_;
-  rsg::UdpSocket socket_;
-  rsg::RobotStateCodec codec_;
-  std::array<std::uint8_t, rsg::kMaxFrameBytes> frame_{};
+  rsg::transport::Endpoint to_;
+  rsg::transport::UdpSocket socket_;
+  rsg::dds::RobotStateCodec codec_;
+  std::array<std::uint8_t, rsg::wire::kMaxFrameBytes> frame_{};
 };
 
 class DdsOutput final : public Output {
@@ -111,7 +112,7 @@ class DdsOutput final : public Output {
   }
 
  private:
-  rsg::Participant participant_;
+  rsg::dds::Participant participant_;
   fdds::DataWriter* writer_;  // owned by participant_
 };
 
@@ -129,7 +130,7 @@ class Player final : public rsg::mcap::RecordVisitor {
       state_channels_.insert(channel.id);
   }
   void on_schema(const rsg::mcap::Schema& schema) override {
-    if (rsg::record::is_robot_state_schema(schema.name)) state_schemas_.insert(schema.id);
+    if (rsg::tools::record::is_robot_state_schema(schema.name)) state_schemas_.insert(schema.id);
   }
   bool on_message(const rsg::mcap::Message& message) override {
     if (!state_channels_.contains(message.channel_id)) return !stop_;
@@ -188,7 +189,7 @@ class Player final : public rsg::mcap::RecordVisitor {
   double speed_;
   const std::atomic<bool>& stop_;
   std::unordered_set<std::uint16_t> state_schemas_, state_channels_;
-  rsg::record::CdrSerializer serializer_;
+  rsg::tools::record::CdrSerializer serializer_;
   rsg::RobotState sample_;
   std::optional<std::uint64_t> first_time_;      // publish time of the pass's first sample
   std::optional<Clock::time_point> pass_start_;  // when the pass's first sample is due
@@ -209,10 +210,10 @@ void add_options(CLI::App& app, Options& options) {
   app.add_option("--wait-for-readers", options.wait_for_readers,
                  "With --domain: wait up to 10 s until this many readers have matched before playing");
   app.add_option("--profiles", options.profiles, "XML profile file or directory (repeatable)")
-      ->default_str(rsg::default_profiles_dir().string());
+      ->default_str(rsg::dds::default_profiles_dir().string());
   app.add_option("--participant-profile", options.participant_profile, "XML participant profile")
       ->capture_default_str();
-  rsg::add_discovery_options(app, options.discovery);
+  rsg::tools::add_discovery_options(app, options.discovery);
   app.add_option("--speed", options.speed, "Play this many times faster than recorded")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -241,12 +242,12 @@ int run(const Options& options) {
 
   std::unique_ptr<Output> output;
   if (options.domain) {
-    rsg::load_profiles(options.profiles, options.participant_profile);
+    rsg::dds::load_profiles(options.profiles, options.participant_profile);
     auto dds = std::make_unique<DdsOutput>(options);
     wait_for_readers(dds->writer(), options.wait_for_readers, stop);
     output = std::move(dds);
   } else {
-    output = std::make_unique<UdpOutput>(rsg::Endpoint::parse(options.to));
+    output = std::make_unique<UdpOutput>(rsg::transport::Endpoint::parse(options.to));
   }
 
   Player player(*output, options.speed, stop);

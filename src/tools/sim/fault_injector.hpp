@@ -11,10 +11,10 @@
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/state_values.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 
 /// Every category of the spec's validation, in its order: what `--corrupt` cycles through by default.
-std::vector<ErrorCategory> all_error_categories();
+std::vector<wire::ErrorCategory> all_error_categories();
 
 struct FaultConfig {
   /// Probability per frame of each fault. A frame suffers at most one fault, so they sum to <= 1.
@@ -28,7 +28,7 @@ struct FaultConfig {
   std::uint64_t reorder_every = 0;
   std::uint64_t corrupt_every = 0;
   /// Categories that successive corrupted frames cycle through, so that each one gets its share.
-  std::vector<ErrorCategory> corrupt_categories = all_error_categories();
+  std::vector<wire::ErrorCategory> corrupt_categories = all_error_categories();
 };
 
 enum class Fault : std::uint8_t { kNone, kDrop, kCorrupt, kDuplicate, kReorder };
@@ -42,7 +42,7 @@ class FaultPlan {
   /// rules that match the same frame, the order is drop, corrupt, duplicate, reorder.
   Fault next(std::uint64_t frame);
   /// The category the next corrupted frame gets.
-  ErrorCategory next_category();
+  wire::ErrorCategory next_category();
   std::mt19937_64& random() { return random_; }
 
  private:
@@ -52,13 +52,13 @@ class FaultPlan {
 };
 
 /// Room a crafted datagram needs: a full frame plus the bytes `length_mismatch` may append.
-inline constexpr std::size_t kCraftedDatagramBytes = kMaxFrameBytes + 16;
+inline constexpr std::size_t kCraftedDatagramBytes = wire::kMaxFrameBytes + 16;
 
 /// Writes to `out` (at least kCraftedDatagramBytes) a datagram that a spec-conformant decoder rejects
 /// with exactly `category`, made from the frame that `values` encodes to (its packet number and,
 /// where the category allows, its selection); `random` picks among the ways to break it.
 /// Returns the datagram's size. kNone gives the valid frame itself.
-std::size_t craft_invalid(ErrorCategory category, const StateValues& values, std::mt19937_64& random,
-                          std::span<std::uint8_t> out);
+std::size_t craft_invalid(wire::ErrorCategory category, const wire::StateValues& values,
+                          std::mt19937_64& random, std::span<std::uint8_t> out);
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

@@ -6,7 +6,7 @@
 
 #include "panda.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 
 /// Position, velocity and acceleration of every joint at one instant.
 struct JointState {
@@ -37,4 +37,4 @@ class JointTrajectory {
   std::array<Harmonic, kHarmonics> harmonics_;
 };
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

@@ -38,17 +38,17 @@ struct Options {
   std::optional<std::uint64_t> count;
   std::optional<double> duration_s;
   std::vector<std::string> every;
-  std::optional<rsg::Selection> base_selection;  // from --groups and --fields
+  std::optional<rsg::wire::Selection> base_selection;  // from --groups and --fields
   unsigned pause_ms = 0;
   std::string report_path;
   std::string record_path;
   std::string pcap_path;
   std::string replay_path;
-  rsg::sim::ReplayOptions replay;
+  rsg::tools::sim::ReplayOptions replay;
 };
 
 constexpr const char* kScheduleHelp = R"(
-Selection and schedule:
+rsg::wire::Selection and schedule:
   Without --groups, --fields or --every, every frame carries all 44 fields (2137 bytes, IP-fragmented
   above a 1500-byte MTU). --groups and --fields select fields for every frame; --every adds a periodic
   entry. Frame k (counted from 0, dropped frames included) carries the union of --groups, --fields and
@@ -79,14 +79,15 @@ Report (--report FILE, and a summary on stderr):
    "restarts","pauses","selection_requests","invalid_requests","send_failures"}
   sent = valid + all invalid (datagrams on the wire, a duplicate counted twice).)";
 
-bool parse_categories(const std::string& list, std::vector<rsg::ErrorCategory>& out, std::string& error) {
+bool parse_categories(const std::string& list, std::vector<rsg::wire::ErrorCategory>& out,
+                      std::string& error) {
   out.clear();
   std::size_t begin = 0;
   while (begin <= list.size()) {
     const std::size_t comma = std::min(list.find(',', begin), list.size());
     const std::string name = list.substr(begin, comma - begin);
-    const auto category = rsg::parse_error_category(name);
-    if (!category || *category == rsg::ErrorCategory::kNone) {
+    const auto category = rsg::wire::parse_error_category(name);
+    if (!category || *category == rsg::wire::ErrorCategory::kNone) {
       error = "'" + name + "' is not an error category of docs/protocol.md";
       return false;
     }
@@ -96,7 +97,7 @@ bool parse_categories(const std::string& list, std::vector<rsg::ErrorCategory>& 
   return true;
 }
 
-void add_options(CLI::App& app, Options& options, rsg::sim::SimConfig& config) {
+void add_options(CLI::App& app, Options& options, rsg::tools::sim::SimConfig& config) {
   app.add_option("--to", options.to, "Where to send frames, HOST:PORT")->required();
   app.add_option("--rate", config.rate_hz, "Frames per second")
       ->check(CLI::Range(1e-3, 1e6))
@@ -111,20 +112,21 @@ void add_options(CLI::App& app, Options& options, rsg::sim::SimConfig& config) {
     app.add_option_function<std::string>(
         name,
         [&options, parse, name](const std::string& list) {
-          rsg::Selection selection;
+          rsg::wire::Selection selection;
           std::string error;
           if (!parse(list, selection, error)) throw CLI::ValidationError(name, error);
           options.base_selection =
-              rsg::sim::unite(options.base_selection.value_or(rsg::Selection{}), selection);
+              rsg::tools::sim::unite(options.base_selection.value_or(rsg::wire::Selection{}), selection);
         },
         help);
   };
-  selection_option("--groups", rsg::parse_group_list, "Comma-separated group numbers 0..5 for every frame");
-  selection_option("--fields", rsg::parse_field_list, "Comma-separated field names for every frame");
+  selection_option("--groups", rsg::wire::parse_group_list,
+                   "Comma-separated group numbers 0..5 for every frame");
+  selection_option("--fields", rsg::wire::parse_field_list, "Comma-separated field names for every frame");
   app.add_option("--every", options.every, "N:LIST, repeatable: LIST in frames whose index N divides");
 
   auto* faults = app.add_option_group("Faults");
-  rsg::sim::FaultConfig& fault = config.faults;
+  rsg::tools::sim::FaultConfig& fault = config.faults;
   const auto probability = [&](const char* name, double& value, const char* what) {
     faults->add_option(name, value, std::string("Probability that a frame is ") + what)
         ->check(CLI::Range(0.0, 1.0));
@@ -178,29 +180,29 @@ void add_options(CLI::App& app, Options& options, rsg::sim::SimConfig& config) {
 }
 
 int run_replay(const Options& options) {
-  const rsg::Endpoint peer = rsg::Endpoint::parse(options.to);
-  rsg::UdpSocket socket = rsg::UdpSocket::for_sending_to(peer);
+  const rsg::transport::Endpoint peer = rsg::transport::Endpoint::parse(options.to);
+  rsg::transport::UdpSocket socket = rsg::transport::UdpSocket::for_sending_to(peer);
   install_stop_handlers();
-  const rsg::sim::ReplayReport report =
-      rsg::sim::replay(options.replay_path, socket, peer, options.replay, g_stop, std::cerr);
+  const rsg::tools::sim::ReplayReport report =
+      rsg::tools::sim::replay(options.replay_path, socket, peer, options.replay, g_stop, std::cerr);
   std::cerr << "rsg_sim: replayed " << report.sent << " datagrams to port " << report.port << " ("
             << report.passes << " complete passes, " << report.send_failures << " send failures)\n";
   return report.send_failures == 0 ? kExitOk : kExitFailure;
 }
 
 /// Turns the selection options into the schedule; throws CLI::ValidationError.
-rsg::sim::Schedule build_schedule(const Options& options) {
-  rsg::sim::Schedule schedule;
+rsg::tools::sim::Schedule build_schedule(const Options& options) {
+  rsg::tools::sim::Schedule schedule;
   if (options.base_selection) schedule.add(1, *options.base_selection);
   for (const std::string& entry : options.every) {
     std::string error;
     if (!schedule.add(entry, error)) throw CLI::ValidationError("--every", error);
   }
-  if (schedule.empty()) schedule.add(1, rsg::Selection::all());
+  if (schedule.empty()) schedule.add(1, rsg::wire::Selection::all());
   return schedule;
 }
 
-void check_probabilities(const rsg::sim::FaultConfig& faults) {
+void check_probabilities(const rsg::tools::sim::FaultConfig& faults) {
   if (faults.drop + faults.duplicate + faults.reorder + faults.corrupt > 1.0)
     throw CLI::ValidationError("--drop/--duplicate/--reorder/--corrupt",
                                "probabilities add up to more than 1");
@@ -214,7 +216,7 @@ int main(int argc, char** argv) {
              "\n\nRuns until --count/--duration or SIGINT/SIGTERM. Exit status: 0 success, 1 runtime "
              "error (socket, file), 2 usage error.");
   Options options;
-  rsg::sim::SimConfig config;
+  rsg::tools::sim::SimConfig config;
   add_options(app, options, config);
   try {
     app.parse(argc, argv);
@@ -227,10 +229,10 @@ int main(int argc, char** argv) {
 
   try {
     if (!options.replay_path.empty()) return run_replay(options);
-    const rsg::Endpoint peer = rsg::Endpoint::parse(options.to);
-    rsg::UdpSocket socket = rsg::UdpSocket::for_sending_to(peer);
-    rsg::sim::UdpLink link(socket, peer);
-    rsg::sim::Simulator sim(config);
+    const rsg::transport::Endpoint peer = rsg::transport::Endpoint::parse(options.to);
+    rsg::transport::UdpSocket socket = rsg::transport::UdpSocket::for_sending_to(peer);
+    rsg::tools::sim::UdpLink link(socket, peer);
+    rsg::tools::sim::Simulator sim(config);
 
     std::ofstream record;
     if (!options.record_path.empty()) {
@@ -242,7 +244,7 @@ int main(int argc, char** argv) {
     std::optional<rsg::capture::PcapWriter> pcap;
     if (!options.pcap_path.empty()) link.capture_to(&pcap.emplace(options.pcap_path));
 
-    rsg::sim::StreamLimits limits;
+    rsg::tools::sim::StreamLimits limits;
     limits.count = options.count;
     if (options.duration_s)
       limits.duration = std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -250,7 +252,7 @@ int main(int argc, char** argv) {
 
     install_stop_handlers();
     std::cerr << "rsg_sim: sending to " << peer.to_string() << " at " << config.rate_hz << " Hz\n";
-    rsg::sim::stream(sim, link, limits, g_stop, std::cerr);
+    rsg::tools::sim::stream(sim, link, limits, g_stop, std::cerr);
 
     std::cerr << "rsg_sim: " << sim.report().summary() << "\n";
     if (!options.report_path.empty()) {

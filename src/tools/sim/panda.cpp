@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-namespace rsg::sim::panda {
+namespace rsg::tools::sim::panda {
 namespace {
 
 // Modified DH parameters (Craig): frame i is reached by RotX(alpha) TransX(a) RotZ(q_i) TransZ(d).
@@ -131,7 +131,7 @@ std::array<PointMass, kJoints + 1> point_masses(const Kinematics& kinematics) {
     const Eigen::Vector3d at = j + 1 < kJoints ? kinematics.origin(j + 1) : kinematics.flange.translation();
     masses[j] = {at, kLinkMass[j], j + 1};
   }
-  masses[kJoints] = {kinematics.flange * eigen::vector3(kHandCentreOfMass), kHandMass, kJoints};
+  masses[kJoints] = {kinematics.flange * dds::eigen::vector3(kHandCentreOfMass), kHandMass, kJoints};
   return masses;
 }
 
@@ -176,4 +176,4 @@ Vector7d Kinematics::gravity_torque_rate(const Vector7d& dq) const {
   return rate;
 }
 
-}  // namespace rsg::sim::panda
+}  // namespace rsg::tools::sim::panda

@@ -9,10 +9,10 @@
 
 #include "rsg/dds/eigen.hpp"
 
-namespace rsg::sim::panda {
+namespace rsg::tools::sim::panda {
 
-using eigen::Vector6d;
-using eigen::Vector7d;
+using dds::eigen::Vector6d;
+using dds::eigen::Vector7d;
 
 inline constexpr std::size_t kJoints = 7;
 
@@ -60,4 +60,4 @@ struct Kinematics {
 /// Forward kinematics from the modified (Craig) DH parameters Franka publishes.
 Kinematics forward_kinematics(const Vector7d& q);
 
-}  // namespace rsg::sim::panda
+}  // namespace rsg::tools::sim::panda

@@ -7,7 +7,7 @@
 #include "joint_trajectory.hpp"
 #include "rsg/wire/state_values.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 
 /// Turns the joint trajectory into a full robot state. Measured values follow the desired ones one
 /// control cycle behind, as a well-tuned joint impedance controller would; there is no contact, no
@@ -21,7 +21,8 @@ class PandaModel {
 
   /// Writes the state `since_start` after the robot started into every field of `out` that `wanted`
   /// selects (others are left as they are); `time` is the whole milliseconds. Does not touch the header.
-  void fill(std::chrono::nanoseconds since_start, const Selection& wanted, StateValues& out) const;
+  void fill(std::chrono::nanoseconds since_start, const wire::Selection& wanted,
+            wire::StateValues& out) const;
 
   const JointTrajectory& trajectory() const { return trajectory_; }
 
@@ -29,4 +30,4 @@ class PandaModel {
   JointTrajectory trajectory_;
 };
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

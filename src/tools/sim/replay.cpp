@@ -7,7 +7,7 @@
 #include "rsg/wire/frame.hpp"
 #include "udp_stream.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -19,13 +19,13 @@ constexpr nanoseconds kSpinWindow = std::chrono::microseconds(200);
 std::uint16_t first_frame_port(const std::string& path) {
   capture::PcapReader reader(path);
   while (const auto packet = reader.next())
-    if (decode(packet->payload)) return packet->to.port;
+    if (wire::decode(packet->payload)) return packet->to.port;
   throw std::runtime_error("'" + path + "' holds no valid SEND_BUF frame; name the port with --port");
 }
 
 }  // namespace
 
-ReplayReport replay(const std::string& path, UdpSocket& socket, const Endpoint& to,
+ReplayReport replay(const std::string& path, transport::UdpSocket& socket, const transport::Endpoint& to,
                     const ReplayOptions& options, const std::atomic<bool>& stop, std::ostream& log) {
   ReplayReport report;
   report.port = options.port ? *options.port : first_frame_port(path);
@@ -63,4 +63,4 @@ ReplayReport replay(const std::string& path, UdpSocket& socket, const Endpoint& 
   return report;
 }
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

@@ -10,7 +10,7 @@
 
 #include "rsg/transport/udp_socket.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 
 struct ReplayOptions {
   double speed = 1.0;  ///< 2: twice as fast; gaps between datagrams are divided by it
@@ -31,7 +31,7 @@ struct ReplayReport {
 /// first one at once and each other one as long after it as the capture says (divided by `speed`).
 /// Invalid frames are sent as they are: a replay reproduces what the robot sent. Throws
 /// std::runtime_error for an unreadable file or one without a SEND_BUF frame to find the port by.
-ReplayReport replay(const std::string& path, UdpSocket& socket, const Endpoint& to,
+ReplayReport replay(const std::string& path, transport::UdpSocket& socket, const transport::Endpoint& to,
                     const ReplayOptions& options, const std::atomic<bool>& stop, std::ostream& log);
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

@@ -2,7 +2,7 @@
 
 #include "rsg/wire/number.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 namespace {
 
 std::string_view trimmed(std::string_view text) {
@@ -11,19 +11,19 @@ std::string_view trimmed(std::string_view text) {
   return text;
 }
 
-bool parse_item(std::string_view item, Selection& selection, std::string& error) {
+bool parse_item(std::string_view item, wire::Selection& selection, std::string& error) {
   if (item == "all") {
-    selection = unite(selection, Selection::all());
+    selection = unite(selection, wire::Selection::all());
     return true;
   }
-  if (const auto field = find_field(item)) {
+  if (const auto field = wire::find_field(item)) {
     selection.add(*field);
     return true;
   }
   // No field name starts with "g" followed by a digit, so group tokens cannot shadow a field.
   if (item.size() >= 2 && item.front() == 'g') {
-    if (const std::optional<unsigned> group = parse_number<unsigned>(item.substr(1));
-        group && *group < kGroupCount) {
+    if (const std::optional<unsigned> group = wire::parse_number<unsigned>(item.substr(1));
+        group && *group < wire::kGroupCount) {
       selection.add_group(*group);
       return true;
     }
@@ -34,16 +34,16 @@ bool parse_item(std::string_view item, Selection& selection, std::string& error)
 
 }  // namespace
 
-Selection unite(const Selection& a, const Selection& b) {
-  Selection both;
+wire::Selection unite(const wire::Selection& a, const wire::Selection& b) {
+  wire::Selection both;
   both.group_select = static_cast<std::uint8_t>(a.group_select | b.group_select);
-  for (std::size_t group = 0; group < kGroupCount; ++group)
+  for (std::size_t group = 0; group < wire::kGroupCount; ++group)
     both.data_select[group] = static_cast<std::uint8_t>(a.data_select[group] | b.data_select[group]);
   return both;
 }
 
-bool parse_selection_items(std::string_view list, Selection& out, std::string& error) {
-  Selection selection;
+bool parse_selection_items(std::string_view list, wire::Selection& out, std::string& error) {
+  wire::Selection selection;
   while (true) {
     const std::size_t comma = list.find(',');
     const std::string_view item = trimmed(list.substr(0, comma));
@@ -66,22 +66,22 @@ bool Schedule::add(std::string_view spec, std::string& error) {
     return false;
   }
   const std::string_view period_text = trimmed(spec.substr(0, colon));
-  const std::uint64_t period = parse_number<std::uint64_t>(period_text).value_or(0);
+  const std::uint64_t period = wire::parse_number<std::uint64_t>(period_text).value_or(0);
   if (period == 0) {
     error = "'" + std::string(period_text) + "' in '" + std::string(spec) + "' is not a period N >= 1";
     return false;
   }
-  Selection selection;
+  wire::Selection selection;
   if (!parse_selection_items(spec.substr(colon + 1), selection, error)) return false;
   add(period, selection);
   return true;
 }
 
-Selection Schedule::at(std::uint64_t frame) const {
-  Selection selection;
+wire::Selection Schedule::at(std::uint64_t frame) const {
+  wire::Selection selection;
   for (const Entry& entry : entries_)
     if (frame % entry.period == 0) selection = unite(selection, entry.selection);
   return selection;
 }
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

@@ -12,14 +12,14 @@
 
 #include "rsg/wire/selection.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 
 /// Bitwise union: the fields of both selections.
-Selection unite(const Selection& a, const Selection& b);
+wire::Selection unite(const wire::Selection& a, const wire::Selection& b);
 
 /// Parses a comma-separated list whose items are field names ("q") or group tokens ("g2"), or the
 /// word "all". On failure returns false and names the offending item in `error`.
-bool parse_selection_items(std::string_view list, Selection& out, std::string& error);
+bool parse_selection_items(std::string_view list, wire::Selection& out, std::string& error);
 
 /// A set of (period, selection) entries. Frame k carries the union of the selections whose period
 /// divides k, so frame 0 carries every entry; a frame that no entry covers carries no field (a valid,
@@ -28,18 +28,20 @@ class Schedule {
  public:
   struct Entry {
     std::uint64_t period = 1;
-    Selection selection;
+    wire::Selection selection;
   };
 
   Schedule() = default;
   /// The same selection in every frame.
-  explicit Schedule(const Selection& every_frame) { add(1, every_frame); }
+  explicit Schedule(const wire::Selection& every_frame) { add(1, every_frame); }
 
-  void add(std::uint64_t period, const Selection& selection) { entries_.push_back({period, selection}); }
+  void add(std::uint64_t period, const wire::Selection& selection) {
+    entries_.push_back({period, selection});
+  }
   /// Adds an entry written "N:LIST" (N >= 1, LIST as parse_selection_items takes it).
   bool add(std::string_view spec, std::string& error);
 
-  Selection at(std::uint64_t frame) const;
+  wire::Selection at(std::uint64_t frame) const;
   bool empty() const { return entries_.empty(); }
   const std::vector<Entry>& entries() const { return entries_; }
 
@@ -47,4 +49,4 @@ class Schedule {
   std::vector<Entry> entries_;
 };
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

@@ -3,7 +3,7 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 
 std::uint64_t SimReport::invalid_total() const {
   return std::accumulate(invalid.begin(), invalid.end(), std::uint64_t{0});
@@ -12,7 +12,7 @@ std::uint64_t SimReport::invalid_total() const {
 std::string SimReport::to_json() const {
   nlohmann::ordered_json invalid_by_category = nlohmann::ordered_json::object();
   for (std::size_t i = 0; i < invalid.size(); ++i)
-    invalid_by_category[std::string(kErrorCategoryNames[i + 1])] = invalid[i];
+    invalid_by_category[std::string(wire::kErrorCategoryNames[i + 1])] = invalid[i];
   const nlohmann::ordered_json report = {
       {"sent", sent},
       {"valid", valid},
@@ -34,7 +34,7 @@ std::string SimReport::summary() const {
                      std::to_string(invalid_total());
   for (std::size_t i = 0; i < invalid.size(); ++i)
     if (invalid[i] != 0)
-      line += " " + std::string(kErrorCategoryNames[i + 1]) + " " + std::to_string(invalid[i]);
+      line += " " + std::string(wire::kErrorCategoryNames[i + 1]) + " " + std::to_string(invalid[i]);
   line += "), dropped " + std::to_string(dropped) + ", duplicated " + std::to_string(duplicated) +
           ", reordered " + std::to_string(reordered) + ", restarts " + std::to_string(restarts) +
           ", pauses " + std::to_string(pauses) + ", selection requests " +
@@ -43,4 +43,4 @@ std::string SimReport::summary() const {
   return line;
 }
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

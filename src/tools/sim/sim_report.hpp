@@ -7,7 +7,7 @@
 
 #include "rsg/wire/error.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 
 /// Counts of datagrams and events. `sent` counts datagrams the kernel accepted (a duplicate twice),
 /// `valid` those among them that decode; every other sent datagram is in `invalid` under the
@@ -18,17 +18,17 @@ struct SimReport {
   std::uint64_t dropped = 0;     ///< frames produced but deliberately not sent
   std::uint64_t duplicated = 0;  ///< frames sent a second time
   std::uint64_t reordered = 0;   ///< frames sent after a later frame
-  std::array<std::uint64_t, kErrorCategoryCount> invalid{};
+  std::array<std::uint64_t, wire::kErrorCategoryCount> invalid{};
   std::uint64_t restarts = 0;
   std::uint64_t pauses = 0;
   std::uint64_t selection_requests = 0;  ///< valid requests applied
   std::uint64_t invalid_requests = 0;    ///< datagrams received that are no valid request
   std::uint64_t send_failures = 0;       ///< datagrams the kernel refused (not in `sent`)
 
-  std::uint64_t& invalid_count(ErrorCategory category) {
+  std::uint64_t& invalid_count(wire::ErrorCategory category) {
     return invalid[static_cast<std::size_t>(category) - 1];
   }
-  std::uint64_t invalid_count(ErrorCategory category) const {
+  std::uint64_t invalid_count(wire::ErrorCategory category) const {
     return invalid[static_cast<std::size_t>(category) - 1];
   }
   std::uint64_t invalid_total() const;
@@ -39,4 +39,4 @@ struct SimReport {
   std::string summary() const;
 };
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

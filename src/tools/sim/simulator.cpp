@@ -5,7 +5,7 @@
 
 #include "rsg/wire/json.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 
 Simulator::Simulator(SimConfig config)
     : config_(std::move(config)),
@@ -13,7 +13,9 @@ Simulator::Simulator(SimConfig config)
       // A different stream from the motion's, so enabling faults does not change the motion.
       faults_(config_.faults, config_.seed ^ 0x9E3779B97F4A7C15ULL) {}
 
-Selection Simulator::next_selection() const { return requested_ ? *requested_ : config_.schedule.at(frame_); }
+wire::Selection Simulator::next_selection() const {
+  return requested_ ? *requested_ : config_.schedule.at(frame_);
+}
 
 void Simulator::produce_frame() {
   if (config_.restart_after != 0 && frame_ == config_.restart_after) {
@@ -25,7 +27,7 @@ void Simulator::produce_frame() {
   const auto since_start =
       std::chrono::nanoseconds(std::llround(static_cast<double>(since_boot) * 1e9 / config_.rate_hz)) +
       paused_since_boot_;
-  values_.packet_number = static_cast<std::uint8_t>(since_boot % kPacketNumberModulo);
+  values_.packet_number = static_cast<std::uint8_t>(since_boot % wire::kPacketNumberModulo);
   values_.selection = next_selection();
   model_.fill(since_start, values_.selection, values_);
 }
@@ -42,11 +44,11 @@ std::chrono::nanoseconds Simulator::step(DatagramSink& sink) {
     current_.size = craft_invalid(current_.category, values_, faults_.random(), current_.bytes);
     emit(current_, sink);
   } else {
-    const EncodeResult encoded = encode(values_.packet_number, values_.selection, values_.storage(),
-                                        StateValues::layout(), current_.bytes);
+    const wire::EncodeResult encoded = encode(values_.packet_number, values_.selection, values_.storage(),
+                                              wire::StateValues::layout(), current_.bytes);
     assert(encoded && "the model only produces encodable values");
     current_.size = encoded.size;
-    current_.category = ErrorCategory::kNone;
+    current_.category = wire::ErrorCategory::kNone;
     if (fault == Fault::kReorder && !holding_) {
       std::swap(held_, current_);
       holding_ = true;
@@ -79,8 +81,8 @@ void Simulator::finish(DatagramSink& sink) {
   holding_ = false;
 }
 
-SelectionRequestResult Simulator::handle_request(std::span<const std::uint8_t> datagram) {
-  const SelectionRequestResult request = decode_selection_request(datagram);
+wire::SelectionRequestResult Simulator::handle_request(std::span<const std::uint8_t> datagram) {
+  const wire::SelectionRequestResult request = wire::decode_selection_request(datagram);
   if (request) {
     requested_ = request.selection;
     ++report_.selection_requests;
@@ -96,7 +98,7 @@ void Simulator::emit(const Datagram& datagram, DatagramSink& sink) {
     return;
   }
   ++report_.sent;
-  if (datagram.category != ErrorCategory::kNone) {
+  if (datagram.category != wire::ErrorCategory::kNone) {
     ++report_.invalid_count(datagram.category);
     return;
   }
@@ -106,13 +108,13 @@ void Simulator::emit(const Datagram& datagram, DatagramSink& sink) {
 
 void Simulator::record(std::span<const std::uint8_t> frame) {
   // Decoding what was sent, rather than printing values_, records exactly what a receiver gets.
-  const DecodeResult decoded = decode(frame);
+  const wire::DecodeResult decoded = wire::decode(frame);
   assert(decoded);
   recorded_.assign(decoded.frame());
   record_line_.clear();
-  append_canonical_json(recorded_, record_line_);
+  wire::append_canonical_json(recorded_, record_line_);
   record_line_ += '\n';
   record_->write(record_line_.data(), static_cast<std::streamsize>(record_line_.size()));
 }
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

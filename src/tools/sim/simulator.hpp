@@ -1,7 +1,7 @@
 // The simulated robot's stream, frame by frame, without sockets or clocks: what `rsg_sim` sends and
 // what the tests drive directly.
 //
-//   rsg::sim::Simulator sim(config);
+//   rsg::tools::sim::Simulator sim(config);
 //   while (running) { pause = sim.step(sink); ... }   // sink.send() gets 0..3 datagrams per step
 //   sim.finish(sink);
 #pragma once
@@ -21,14 +21,14 @@
 #include "schedule.hpp"
 #include "sim_report.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 
 struct SimConfig {
   /// Frames per second of robot time: frame n is stamped n / rate_hz after the robot started.
   double rate_hz = 1000;
   /// Seeds the motion and the faults; the same seed and config give the same datagrams.
   std::uint64_t seed = 1;
-  Schedule schedule{Selection::all()};
+  Schedule schedule{wire::Selection::all()};
   FaultConfig faults;
   /// After this many frames (0: never), the link goes silent for `pause`; the robot's clock and
   /// motion keep running, so the next frame's `time` jumps while its packet number follows on.
@@ -59,7 +59,7 @@ class Simulator {
 
   /// Applies a selection request (docs/protocol.md) received from the gateway: from the next frame on,
   /// the requested selection replaces the schedule. Invalid requests are counted and ignored.
-  SelectionRequestResult handle_request(std::span<const std::uint8_t> datagram);
+  wire::SelectionRequestResult handle_request(std::span<const std::uint8_t> datagram);
 
   /// Writes the canonical JSON of every valid datagram sent, one line each, to `out` (null: stop).
   void record_to(std::ostream* out) { record_ = out; }
@@ -69,14 +69,14 @@ class Simulator {
   std::uint64_t frames() const { return frame_; }
   const SimConfig& config() const { return config_; }
   /// The selection that the next frame gets unless a request arrives first.
-  Selection next_selection() const;
+  wire::Selection next_selection() const;
 
  private:
   // A datagram and what a decoder will make of it (kNone: a valid frame).
   struct Datagram {
     std::array<std::uint8_t, kCraftedDatagramBytes> bytes{};
     std::size_t size = 0;
-    ErrorCategory category = ErrorCategory::kNone;
+    wire::ErrorCategory category = wire::ErrorCategory::kNone;
     std::span<const std::uint8_t> view() const { return {bytes.data(), size}; }
   };
 
@@ -87,21 +87,21 @@ class Simulator {
   SimConfig config_;
   PandaModel model_;
   FaultPlan faults_;
-  std::optional<Selection> requested_;
+  std::optional<wire::Selection> requested_;
   SimReport report_;
 
   std::uint64_t frame_ = 0;       // frames produced since the start
   std::uint64_t boot_frame_ = 0;  // frame_ at the last (re)start
   std::chrono::nanoseconds paused_since_boot_{0};
 
-  StateValues values_;
+  wire::StateValues values_;
   Datagram current_;
   Datagram held_;  // a frame waiting to be sent after the next valid one
   bool holding_ = false;
 
   std::ostream* record_ = nullptr;
-  StateValues recorded_;
+  wire::StateValues recorded_;
   std::string record_line_;
 };
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

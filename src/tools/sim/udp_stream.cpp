@@ -6,7 +6,7 @@
 #include <cmath>
 #include <thread>
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -18,9 +18,9 @@ constexpr nanoseconds kSpinWindow = std::chrono::microseconds(200);
 constexpr nanoseconds kLongestSleep = std::chrono::milliseconds(50);
 constexpr double kRequestPollsPerSecond = 1000;
 
-std::string describe(const Selection& selection) {
+std::string describe(const wire::Selection& selection) {
   std::string fields;
-  for (const FieldInfo& field : kFields)
+  for (const wire::FieldInfo& field : wire::kFields)
     if (selection.contains(field.id())) fields += (fields.empty() ? "" : ",") + std::string(field.name);
   return fields.empty() ? "no field" : fields;
 }
@@ -47,7 +47,7 @@ bool UdpLink::send(std::span<const std::uint8_t> datagram) {
       capture_to_ = capture::endpoint_of(peer_.address());
       // The socket is unbound, so its address reads 0.0.0.0; the address the kernel sends from is
       // that of a UDP socket connected to the peer (connecting sends nothing).
-      UdpSocket probe = UdpSocket::for_sending_to(peer_);
+      transport::UdpSocket probe = transport::UdpSocket::for_sending_to(peer_);
       if (::connect(probe.fd(), peer_.address(), peer_.size()) == 0)
         capture_from_->ip = capture::endpoint_of(probe.local_endpoint().address()).ip;
     }
@@ -58,16 +58,16 @@ bool UdpLink::send(std::span<const std::uint8_t> datagram) {
 }
 
 void UdpLink::poll_requests(Simulator& sim, std::ostream& log) {
-  Endpoint from;
+  transport::Endpoint from;
   while (const auto size = socket_.receive(request_, &from, std::chrono::milliseconds(0))) {
     const std::size_t kept = std::min(*size, request_.size());
-    const SelectionRequestResult request = sim.handle_request({request_.data(), kept});
+    const wire::SelectionRequestResult request = sim.handle_request({request_.data(), kept});
     if (request)
       log << "rsg_sim: selection request from " << from.to_string() << ": now sending "
           << describe(request.selection) << "\n";
     else
       log << "rsg_sim: ignored an invalid selection request from " << from.to_string() << " ("
-          << to_string(request.error.category()) << ": " << request.error.message() << ")\n";
+          << wire::to_string(request.error.category()) << ": " << request.error.message() << ")\n";
   }
 }
 
@@ -96,4 +96,4 @@ void stream(Simulator& sim, UdpLink& link, const StreamLimits& limits, const std
   sim.finish(link);
 }
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

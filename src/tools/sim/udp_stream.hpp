@@ -12,13 +12,13 @@
 #include "rsg/transport/udp_socket.hpp"
 #include "simulator.hpp"
 
-namespace rsg::sim {
+namespace rsg::tools::sim {
 
 /// Sends to one peer, and reads the selection requests that the peer (or anyone) sends back to the
 /// socket's address, which a receiver learns from the source of the datagrams.
 class UdpLink final : public DatagramSink {
  public:
-  UdpLink(UdpSocket& socket, const Endpoint& peer) : socket_(socket), peer_(peer) {}
+  UdpLink(transport::UdpSocket& socket, const transport::Endpoint& peer) : socket_(socket), peer_(peer) {}
 
   /// Sends, and writes the datagram to the capture when there is one (`rsg_sim --pcap`).
   bool send(std::span<const std::uint8_t> datagram) override;
@@ -28,11 +28,11 @@ class UdpLink final : public DatagramSink {
   void poll_requests(Simulator& sim, std::ostream& log);
 
  private:
-  UdpSocket& socket_;
-  Endpoint peer_;
+  transport::UdpSocket& socket_;
+  transport::Endpoint peer_;
   capture::PcapWriter* capture_ = nullptr;
   std::optional<capture::UdpEndpoint> capture_from_, capture_to_;  // known after the first send
-  std::array<std::uint8_t, kMaxFrameBytes + 1> request_{};         // + 1: an oversized datagram shows as one
+  std::array<std::uint8_t, wire::kMaxFrameBytes + 1> request_{};   // + 1: an oversized datagram shows as one
 };
 
 struct StreamLimits {
@@ -53,4 +53,4 @@ void wait_until(std::chrono::steady_clock::time_point deadline, std::chrono::nan
 void stream(Simulator& sim, UdpLink& link, const StreamLimits& limits, const std::atomic<bool>& stop,
             std::ostream& log);
 
-}  // namespace rsg::sim
+}  // namespace rsg::tools::sim

@@ -42,7 +42,7 @@ struct Options : rsg::tools::MonitorOptions {
   std::string listen = "127.0.0.1:8765";
   double page_rate_hz = 30;
   std::string chart_js = RSG_CHART_JS;
-  rsg::view::ServerOptions server;
+  rsg::tools::view::ServerOptions server;
 };
 
 std::uint64_t now_ns() {
@@ -51,10 +51,10 @@ std::uint64_t now_ns() {
                                         .count());
 }
 
-rsg::view::Payload payload_of(std::span<const std::uint8_t> bytes) {
+rsg::tools::view::Payload payload_of(std::span<const std::uint8_t> bytes) {
   return std::make_shared<const std::vector<std::uint8_t>>(bytes.begin(), bytes.end());
 }
-rsg::view::Payload payload_of(const std::string& text) {
+rsg::tools::view::Payload payload_of(const std::string& text) {
   return std::make_shared<const std::vector<std::uint8_t>>(text.begin(), text.end());
 }
 
@@ -77,10 +77,10 @@ void add_options(CLI::App& app, Options& options) {
       ->capture_default_str();
 }
 
-std::vector<rsg::view::WebFile> web_files(const Options& options) {
-  std::vector<rsg::view::WebFile> files{
-      {"/", "text/html; charset=utf-8", std::string(rsg::view::web::kIndexHtml)},
-      {"/app.js", "text/javascript; charset=utf-8", std::string(rsg::view::web::kAppJs)},
+std::vector<rsg::tools::view::WebFile> web_files(const Options& options) {
+  std::vector<rsg::tools::view::WebFile> files{
+      {"/", "text/html; charset=utf-8", std::string(rsg::tools::view::web::kIndexHtml)},
+      {"/app.js", "text/javascript; charset=utf-8", std::string(rsg::tools::view::web::kAppJs)},
   };
   std::ifstream in(options.chart_js, std::ios::binary);
   if (!in) {
@@ -94,8 +94,9 @@ std::vector<rsg::view::WebFile> web_files(const Options& options) {
   return files;
 }
 
-void split_listen(const std::string& text, rsg::view::ServerOptions& server) {
-  const rsg::Endpoint endpoint = rsg::Endpoint::parse(text);  // throws std::invalid_argument
+void split_listen(const std::string& text, rsg::tools::view::ServerOptions& server) {
+  const rsg::transport::Endpoint endpoint =
+      rsg::transport::Endpoint::parse(text);  // throws std::invalid_argument
   std::string host = endpoint.to_string();
   host.resize(host.rfind(':'));
   if (host.size() >= 2 && host.front() == '[') host = host.substr(1, host.size() - 2);
@@ -105,20 +106,20 @@ void split_listen(const std::string& text, rsg::view::ServerOptions& server) {
 
 int run(const Options& options) {
   StopOnSignal::block_stop_signals();
-  rsg::view::ChannelSet channels(options.topic, options.status_topic);
-  rsg::view::Server server(options.server, channels.channels(), web_files(options));
+  rsg::tools::view::ChannelSet channels(options.topic, options.status_topic);
+  rsg::tools::view::Server server(options.server, channels.channels(), web_files(options));
   std::cerr << "rsg_view: serving ws://" << options.server.host << ":" << server.port() << " and http://"
             << options.server.host << ":" << server.port() << "/\n";
 
-  rsg::Participant participant(options.domain, options.participant_profile, options.discovery);
+  rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery);
   rsg::tools::MonitorReaders readers(participant, options.topics());
   StopOnSignal stop_on_signal([&readers] { readers.request_stop(); });
 
   const auto page_period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(1.0 / options.page_rate_hz));
   auto next_page = std::chrono::steady_clock::now();
-  rsg::record::CdrSerializer serializer;
-  rsg::view::PageSummary summary;
+  rsg::tools::record::CdrSerializer serializer;
+  rsg::tools::view::PageSummary summary;
   rsg::RobotState state;
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
@@ -132,7 +133,7 @@ int run(const Options& options) {
       const std::uint64_t time = now_ns();
       const auto cdr = payload_of(serializer.serialize(state));
       for (const auto channel : channels.robot_state_cdr()) server.publish(channel, time, cdr);
-      if (const auto transform = rsg::view::frame_transform_json(state, time))
+      if (const auto transform = rsg::tools::view::frame_transform_json(state, time))
         server.publish(channels.transform(), time, payload_of(*transform));
       summary.add(state);
       summary_pending = true;
@@ -143,7 +144,7 @@ int run(const Options& options) {
       const std::uint64_t time = now_ns();
       const auto cdr = payload_of(serializer.serialize(status));
       for (const auto channel : channels.status_cdr()) server.publish(channel, time, cdr);
-      server.publish(channels.status_json(), time, payload_of(rsg::view::status_json(status)));
+      server.publish(channels.status_json(), time, payload_of(rsg::tools::view::status_json(status)));
     }
     // Also once a second when nothing arrives, so that a page opened after the stream stopped shows
     // its last state.

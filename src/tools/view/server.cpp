@@ -18,7 +18,7 @@
 #include <thread>
 #include <variant>
 
-namespace rsg::view {
+namespace rsg::tools::view {
 namespace {
 
 namespace beast = boost::beast;
@@ -444,4 +444,4 @@ std::vector<ChannelCount> Server::channel_counts() const {
   return counts;
 }
 
-}  // namespace rsg::view
+}  // namespace rsg::tools::view

@@ -17,7 +17,7 @@
 
 #include "foxglove_protocol.hpp"
 
-namespace rsg::view {
+namespace rsg::tools::view {
 
 struct ServerOptions {
   std::string host = "127.0.0.1";
@@ -66,4 +66,4 @@ class Server {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace rsg::view
+}  // namespace rsg::tools::view

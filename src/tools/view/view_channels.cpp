@@ -8,11 +8,11 @@
 #include "rsg/wire/error_flags.hpp"
 #include "status_sample.hpp"
 
-namespace rsg::view {
+namespace rsg::tools::view {
 namespace {
 
 using nlohmann::json;
-namespace schemas = rsg::record::schemas;
+namespace schemas = rsg::tools::record::schemas;
 
 // JSON Schemas of the JSON channels: Foxglove wants one per channel; these say the shape.
 constexpr std::string_view kFrameTransformSchema = R"({"type":"object","properties":{
@@ -24,8 +24,8 @@ constexpr std::string_view kObjectSchema = R"({"type":"object"})";
 
 json error_names(std::uint64_t bits) {
   json names = json::array();
-  for (std::size_t i = 0; i < kErrorFlagCount; ++i)
-    if ((bits >> i) & 1U) names.push_back(kErrorFlagNames[i]);
+  for (std::size_t i = 0; i < wire::kErrorFlagCount; ++i)
+    if ((bits >> i) & 1U) names.push_back(wire::kErrorFlagNames[i]);
   return names;
 }
 
@@ -64,8 +64,8 @@ ChannelSet::ChannelSet(const std::string& state_topic, const std::string& status
 }
 
 std::optional<std::string> frame_transform_json(const RobotState& sample, std::uint64_t time_ns) {
-  if (!selection_of(sample).contains(Field::O_T_EE)) return std::nullopt;
-  const Eigen::Isometry3d pose = eigen::isometry(sample.O_T_EE());
+  if (!dds::selection_of(sample).contains(wire::Field::O_T_EE)) return std::nullopt;
+  const Eigen::Isometry3d pose = dds::eigen::isometry(sample.O_T_EE());
   const Eigen::Vector3d t = pose.translation();
   // A frame from a real controller holds a rotation; normalizing keeps Foxglove's 3D panel sane otherwise.
   const Eigen::Quaterniond r = Eigen::Quaterniond(pose.linear()).normalized();
@@ -83,20 +83,20 @@ std::string status_json(const GatewayStatus& sample) {
 
 void PageSummary::add(const RobotState& sample) {
   ++samples_;
-  const Selection selection = selection_of(sample);
-  if (selection.contains(Field::time)) time_ = sample.time();
-  if (selection.contains(Field::robot_mode)) robot_mode_ = sample.robot_mode();
-  if (selection.contains(Field::q)) q_ = sample.q();
-  if (selection.contains(Field::dq)) dq_ = sample.dq();
-  if (selection.contains(Field::tau_J)) tau_J_ = sample.tau_J();
-  if (selection.contains(Field::O_T_EE)) {
-    const Eigen::Vector3d t = eigen::pose(sample.O_T_EE()).block<3, 1>(0, 3);
+  const wire::Selection selection = dds::selection_of(sample);
+  if (selection.contains(wire::Field::time)) time_ = sample.time();
+  if (selection.contains(wire::Field::robot_mode)) robot_mode_ = sample.robot_mode();
+  if (selection.contains(wire::Field::q)) q_ = sample.q();
+  if (selection.contains(wire::Field::dq)) dq_ = sample.dq();
+  if (selection.contains(wire::Field::tau_J)) tau_J_ = sample.tau_J();
+  if (selection.contains(wire::Field::O_T_EE)) {
+    const Eigen::Vector3d t = dds::eigen::pose(sample.O_T_EE()).block<3, 1>(0, 3);
     ee_position_ = std::array<double, 3>{t.x(), t.y(), t.z()};
   }
-  if (selection.contains(Field::control_command_success_rate))
+  if (selection.contains(wire::Field::control_command_success_rate))
     success_rate_ = sample.control_command_success_rate();
-  if (selection.contains(Field::current_errors)) current_errors_ = sample.current_errors();
-  if (selection.contains(Field::last_motion_errors)) last_motion_errors_ = sample.last_motion_errors();
+  if (selection.contains(wire::Field::current_errors)) current_errors_ = sample.current_errors();
+  if (selection.contains(wire::Field::last_motion_errors)) last_motion_errors_ = sample.last_motion_errors();
 }
 
 std::string PageSummary::json(std::uint64_t dropped) const {
@@ -114,8 +114,9 @@ std::string PageSummary::json(std::uint64_t dropped) const {
       {"last_motion_errors",
        last_motion_errors_ ? error_names(*last_motion_errors_) : nlohmann::json(nullptr)},
       {"dropped", dropped}};
-  if (robot_mode_ && *robot_mode_ <= kMaxRobotMode) out["robot_mode_name"] = kRobotModeNames[*robot_mode_];
+  if (robot_mode_ && *robot_mode_ <= wire::kMaxRobotMode)
+    out["robot_mode_name"] = wire::kRobotModeNames[*robot_mode_];
   return out.dump();
 }
 
-}  // namespace rsg::view
+}  // namespace rsg::tools::view

@@ -14,7 +14,7 @@
 
 #include "foxglove_protocol.hpp"
 
-namespace rsg::view {
+namespace rsg::tools::view {
 
 class ChannelSet {
  public:
@@ -66,4 +66,4 @@ class PageSummary {
   std::optional<std::uint64_t> current_errors_, last_motion_errors_;
 };
 
-}  // namespace rsg::view
+}  // namespace rsg::tools::view

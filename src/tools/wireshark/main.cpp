@@ -23,15 +23,15 @@ namespace {
 constexpr unsigned kDocumentedGatewayPort = 17000;
 constexpr std::string_view kPlaceholder = "@RSG_GENERATED_TABLES@";
 
-std::string_view type_name(rsg::ElementType type) {
+std::string_view type_name(rsg::wire::ElementType type) {
   switch (type) {
-    case rsg::ElementType::kFloat64:
+    case rsg::wire::ElementType::kFloat64:
       return "float64";
-    case rsg::ElementType::kErrorSet:
+    case rsg::wire::ElementType::kErrorSet:
       return "error_set";
-    case rsg::ElementType::kUInt8:
+    case rsg::wire::ElementType::kUInt8:
       return "uint8";
-    case rsg::ElementType::kUInt64:
+    case rsg::wire::ElementType::kUInt64:
       return "uint64";
   }
   return "";
@@ -51,17 +51,17 @@ std::string tables() {
   std::ostringstream lua;
   lua << "-- Tables generated from include/rsg/wire/{field_table,field_docs,error_flags,error}.hpp.\n";
   lua << "local DEFAULT_PORT = " << kDocumentedGatewayPort << "\n";
-  lua << "local REQUEST_TYPE = " << unsigned{rsg::kRequestType} << "\n";
-  lua << "local GROUP_COUNT = " << rsg::kGroupCount << "\n";
-  lua << "local MAX_ROBOT_MODE = " << unsigned{rsg::kMaxRobotMode} << "\n";
-  lua << "local ERROR_FLAG_COUNT = " << rsg::kErrorFlagCount << "\n";
+  lua << "local REQUEST_TYPE = " << unsigned{rsg::wire::kRequestType} << "\n";
+  lua << "local GROUP_COUNT = " << rsg::wire::kGroupCount << "\n";
+  lua << "local MAX_ROBOT_MODE = " << unsigned{rsg::wire::kMaxRobotMode} << "\n";
+  lua << "local ERROR_FLAG_COUNT = " << rsg::wire::kErrorFlagCount << "\n";
   lua << "-- Validation categories in the order the spec checks them.\nlocal ERROR_CATEGORIES = {";
-  for (std::size_t i = 1; i < rsg::kErrorCategoryNames.size(); ++i)
-    lua << (i == 1 ? " " : ", ") << quoted(rsg::kErrorCategoryNames[i]);
+  for (std::size_t i = 1; i < rsg::wire::kErrorCategoryNames.size(); ++i)
+    lua << (i == 1 ? " " : ", ") << quoted(rsg::wire::kErrorCategoryNames[i]);
   lua << " }\n";
   lua << "-- The field table in field-index order (the order of the data section).\nlocal FIELDS = {\n";
-  for (const rsg::FieldInfo& field : rsg::kFields) {
-    const rsg::FieldDoc doc = rsg::field_doc(field.id());
+  for (const rsg::wire::FieldInfo& field : rsg::wire::kFields) {
+    const rsg::wire::FieldDoc doc = rsg::wire::field_doc(field.id());
     char mask[8];
     std::snprintf(mask, sizeof mask, "0x%02x", unsigned{field.mask});
     lua << "  { name = " << quoted(field.name) << ", index = " << unsigned{field.index}
@@ -71,11 +71,11 @@ std::string tables() {
         << ", unit = " << quoted(doc.unit) << ", meaning = " << quoted(doc.meaning) << " },\n";
   }
   lua << "}\n-- Error-set bit -> flag name.\nlocal ERROR_FLAGS = {\n";
-  for (std::size_t i = 0; i < rsg::kErrorFlagNames.size(); ++i)
-    lua << "  [" << i << "] = " << quoted(rsg::kErrorFlagNames[i]) << ",\n";
+  for (std::size_t i = 0; i < rsg::wire::kErrorFlagNames.size(); ++i)
+    lua << "  [" << i << "] = " << quoted(rsg::wire::kErrorFlagNames[i]) << ",\n";
   lua << "}\nlocal ROBOT_MODES = {";
-  for (std::size_t i = 0; i < rsg::kRobotModeNames.size(); ++i)
-    lua << (i == 0 ? " " : ", ") << "[" << i << "] = " << quoted(rsg::kRobotModeNames[i]);
+  for (std::size_t i = 0; i < rsg::wire::kRobotModeNames.size(); ++i)
+    lua << (i == 0 ? " " : ", ") << "[" << i << "] = " << quoted(rsg::wire::kRobotModeNames[i]);
   lua << " }";
   return lua.str();
 }

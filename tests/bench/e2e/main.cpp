@@ -169,7 +169,7 @@ int main(int argc, char** argv) {
   BenchOptions options;
   options.domain = static_cast<int>(::getpid() % 200 + 10);
   options.bin_dir = own_directory();
-  options.profiles_dir = rsg::default_profiles_dir();
+  options.profiles_dir = rsg::dds::default_profiles_dir();
   std::filesystem::path bench_profiles = RSG_BENCH_PROFILES;
   std::string scenario, role, transport = "udp", out;
   std::vector<double> max_rate_steps = {1000, 2000, 5000, 10000, 20000, 50000, 100000};
@@ -221,7 +221,7 @@ int main(int argc, char** argv) {
 
   if (role == "relay") {
     try {
-      rsg::load_profiles(options.profiles_dir);
+      rsg::dds::load_profiles(options.profiles_dir);
       rsg::bench::run_relay_role(options);
       return 0;
     } catch (const std::exception& error) {
@@ -231,7 +231,7 @@ int main(int argc, char** argv) {
   }
   if (role == "writer") {
     try {
-      rsg::load_profiles(options.profiles_dir);
+      rsg::dds::load_profiles(options.profiles_dir);
       const json result = rsg::bench::run_writer_role(options, transport_named(transport));
       if (result["send_failed"].get<std::uint64_t>() != 0)
         throw std::runtime_error("the writer refused samples");
@@ -252,7 +252,7 @@ int main(int argc, char** argv) {
   try {
     options.scratch_dir = scratch.path();
     options.profiles_dir = link_profiles(options.profiles_dir, bench_profiles, scratch.path());
-    rsg::load_profiles(options.profiles_dir);
+    rsg::dds::load_profiles(options.profiles_dir);
     if (smoke) return run_smoke(options);
 
     const json load_at_start = load_average();

@@ -13,13 +13,14 @@
 #include <string>
 
 namespace rsg::bench {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 /// Takes every message of one topic in its listener and counts the valid ones.
 template <class Message, class PubSubType>
 class CountingReader : private fdds::DataReaderListener {
  public:
-  CountingReader(Participant& participant, fdds::Subscriber& subscriber, const std::string& topic)
+  CountingReader(dds::Participant& participant, fdds::Subscriber& subscriber, const std::string& topic)
       : subscriber_(subscriber) {
     fdds::DataReaderQos qos = subscriber.get_default_datareader_qos();
     qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
@@ -52,7 +53,7 @@ class CountingReader : private fdds::DataReaderListener {
 }  // namespace
 
 struct Ros2StandardReaders::Readers {
-  explicit Readers(Participant& participant)
+  explicit Readers(dds::Participant& participant)
       : subscriber(*participant.subscriber()),
         joint_states(participant, subscriber, "joint_states"),
         tf(participant, subscriber, "tf"),
@@ -66,7 +67,7 @@ struct Ros2StandardReaders::Readers {
       wrench;
 };
 
-Ros2StandardReaders::Ros2StandardReaders(Participant& participant)
+Ros2StandardReaders::Ros2StandardReaders(dds::Participant& participant)
     : readers_(std::make_unique<Readers>(participant)) {}
 
 Ros2StandardReaders::~Ros2StandardReaders() = default;

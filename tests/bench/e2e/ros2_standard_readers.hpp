@@ -14,7 +14,7 @@ class Ros2StandardReaders {
  public:
   /// Reliable, volatile readers of joint_states, tf and external_wrench in `participant`.
   /// Throws std::runtime_error.
-  explicit Ros2StandardReaders(Participant& participant);
+  explicit Ros2StandardReaders(dds::Participant& participant);
   ~Ros2StandardReaders();
   Ros2StandardReaders(const Ros2StandardReaders&) = delete;
   Ros2StandardReaders& operator=(const Ros2StandardReaders&) = delete;

@@ -28,6 +28,7 @@
 #include "state_subscriber.hpp"
 
 namespace rsg::bench {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 using json = nlohmann::json;
@@ -107,15 +108,16 @@ SendReport send_paced(std::uint64_t first, std::uint64_t count, double rate_hz, 
 /// Sends stamped frames to one UDP destination: `send(k)` stamps frame k now and sends it.
 class FrameSender {
  public:
-  explicit FrameSender(const Endpoint& to) : to_(to), socket_(UdpSocket::for_sending_to(to)) {}
+  explicit FrameSender(const transport::Endpoint& to)
+      : to_(to), socket_(transport::UdpSocket::for_sending_to(to)) {}
   bool operator()(std::uint64_t k) {
     frames_.stamp_now(k);
     return socket_.send_to(frames_.encode(), to_);
   }
 
  private:
-  Endpoint to_;
-  UdpSocket socket_;
+  transport::Endpoint to_;
+  transport::UdpSocket socket_;
   StampedFrames frames_;
 };
 
@@ -189,7 +191,7 @@ class GatewayProcess {
         process_(concat(std::move(argv), more_args), log_),
         ingress_(wait_for_ingress()) {}
 
-  const Endpoint& ingress() const { return ingress_; }
+  const transport::Endpoint& ingress() const { return ingress_; }
   pid_t pid() const { return process_.pid(); }
 
   /// Stops it and returns the counters of its final stats file.
@@ -206,15 +208,15 @@ class GatewayProcess {
   }
   // The relay logs where it listens ("... frames on UDP 127.0.0.1:PORT -> ..."): with port 0 that
   // is the only race-free way to learn the port.
-  Endpoint wait_for_ingress() {
+  transport::Endpoint wait_for_ingress() {
     const std::string rest = wait_for_log_line(log_, "frames on UDP ", process_);
-    return Endpoint::parse(std::string_view(rest).substr(0, rest.find(' ')));
+    return transport::Endpoint::parse(std::string_view(rest).substr(0, rest.find(' ')));
   }
 
   std::filesystem::path log_;
   std::filesystem::path stats_;
   ChildProcess process_;
-  Endpoint ingress_;
+  transport::Endpoint ingress_;
 };
 
 /// The bench's Cyclone DDS reader (floor/cyclone_reader.cpp) as a child process.
@@ -274,7 +276,7 @@ json run_gateway(const BenchOptions& options, const Transport& transport) {
   const std::string topic = options.topic + "_" + label;
   GatewayProcess gateway(options, transport, topic, label);
 
-  Participant participant(options.domain, std::string(transport.participant_profile));
+  dds::Participant participant(options.domain, std::string(transport.participant_profile));
   LatencyLog log(options.warmup_frames(), options.measured_frames());
   LatencyLog notified(options.warmup_frames(), options.measured_frames());
   StateSubscriber subscriber(participant, topic, options.reader_profile_for(transport), log,
@@ -322,7 +324,7 @@ json run_gateway_ros2_standard(const BenchOptions& options, double ros2_standard
   for (const char* flag : {"--joint-states", "--tf", "--external-wrench"})
     with_topics.gateway_args.insert(with_topics.gateway_args.end(), {flag, hz});
   const Transport& udp = transport_named("udp");
-  Participant participant(options.domain, std::string(udp.participant_profile));
+  dds::Participant participant(options.domain, std::string(udp.participant_profile));
   const Ros2StandardReaders readers(participant);
   json result = run_gateway(with_topics, udp);
   result["ros2_standard_hz"] = ros2_standard_hz;
@@ -341,21 +343,21 @@ json run_embedded(const BenchOptions& options) {
   for (const std::string& arg : options.gateway_args)
     if (const auto equals = arg.find('='); arg.starts_with("--") && equals != std::string::npos)
       more += arg.substr(2, equals - 2) + ": " + arg.substr(equals + 1) + "\n";
-  EmbeddedGateway gateway(more + "listen: 127.0.0.1:0\ndomain: " + std::to_string(options.domain) +
-                              "\ntopic: " + topic + "\nstatus-topic: " + topic +
-                              "_status\nprofiles: " + options.profiles_dir.string() +
-                              "\nwriter-profile: " + options.writer_profile + "\n",
-                          [&](const RobotState& sample) {
-                            const std::int64_t received_ns = monotonic_ns();
-                            callback_log.record(read_stamp(sample), received_ns);
-                          });
+  gateway::EmbeddedGateway gateway(more + "listen: 127.0.0.1:0\ndomain: " + std::to_string(options.domain) +
+                                       "\ntopic: " + topic + "\nstatus-topic: " + topic +
+                                       "_status\nprofiles: " + options.profiles_dir.string() +
+                                       "\nwriter-profile: " + options.writer_profile + "\n",
+                                   [&](const RobotState& sample) {
+                                     const std::int64_t received_ns = monotonic_ns();
+                                     callback_log.record(read_stamp(sample), received_ns);
+                                   });
   // Another participant (intra-process delivery is off in this binary): a remote reader's view.
   const Transport& udp = transport_named("udp");
-  Participant participant(options.domain, std::string(udp.participant_profile));
+  dds::Participant participant(options.domain, std::string(udp.participant_profile));
   StateSubscriber subscriber(participant, topic, options.reader_profile_for(udp), reader_log);
   require(subscriber.wait_for_writer(kStartupTimeout), "the embedded gateway's writer never matched");
 
-  const Endpoint to = gateway.local_endpoint();
+  const transport::Endpoint to = gateway.local_endpoint();
   FrameSender send(to);
   send_paced(0, options.warmup_frames(), options.rate_hz, send);
   const ProcessUsage before = read_usage(::getpid());
@@ -414,7 +416,7 @@ json run_floor(const BenchOptions& options, std::string_view publisher, std::str
                        publisher == "gateway" ? options.gateway_args : std::vector<std::string>{});
 
   LatencyLog log(options.warmup_frames(), options.measured_frames());
-  std::optional<Participant> participant;
+  std::optional<dds::Participant> participant;
   std::optional<StateSubscriber> fastdds_reader;
   std::optional<CycloneReader> cyclone_reader;
   if (reader == "fastdds") {
@@ -445,7 +447,7 @@ json run_floor(const BenchOptions& options, std::string_view publisher, std::str
 }
 
 json run_relay_role(const BenchOptions& options) {
-  Participant participant(options.domain, std::string(transport_named("udp").participant_profile));
+  dds::Participant participant(options.domain, std::string(transport_named("udp").participant_profile));
   fdds::DataWriter* writer = participant.publisher()->create_datawriter_with_profile(
       participant.robot_state_topic(options.topic), options.writer_profile);
   require(writer != nullptr, "cannot create a writer with profile '" + options.writer_profile + "'");
@@ -493,20 +495,21 @@ json run_max_rate(const BenchOptions& options, const Transport& transport, const
 }
 
 json run_udp_oneway(const BenchOptions& options) {
-  UdpSocket receiver = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
+  transport::UdpSocket receiver = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
   receiver.set_receive_buffer(kReceiveBufferBytes);
-  const Endpoint destination = receiver.local_endpoint();
+  const transport::Endpoint destination = receiver.local_endpoint();
   LatencyLog log(options.warmup_frames(), options.measured_frames());
 
   // Receives as the gateway does (poll, then recvfrom into a buffer allocated up front), stamps,
   // and only then decodes to find the frame's own stamp.
   std::jthread receiving([&](std::stop_token stop) {
-    std::vector<std::uint8_t> datagram(kMaxFrameBytes + 1);
+    std::vector<std::uint8_t> datagram(wire::kMaxFrameBytes + 1);
     while (!stop.stop_requested()) {
       const auto size = receiver.receive(datagram, nullptr, milliseconds(100));
       if (!size) continue;
       const std::int64_t received_ns = monotonic_ns();
-      const DecodeResult decoded = decode(std::span(datagram).first(std::min(*size, datagram.size())));
+      const wire::DecodeResult decoded =
+          wire::decode(std::span(datagram).first(std::min(*size, datagram.size())));
       if (!decoded) continue;
       if (const auto stamp = read_stamp(decoded.frame())) log.record(*stamp, received_ns);
     }
@@ -527,7 +530,7 @@ json run_udp_oneway(const BenchOptions& options) {
 json run_fastdds(const BenchOptions& options, const Transport& transport) {
   const std::string label = label_of(transport, options.rate_hz);
   const std::string topic = options.topic + "_plain_" + label;
-  Participant participant(options.domain, std::string(transport.participant_profile));
+  dds::Participant participant(options.domain, std::string(transport.participant_profile));
   LatencyLog log(options.warmup_frames(), options.measured_frames());
   LatencyLog notified(options.warmup_frames(), options.measured_frames());
   StateSubscriber subscriber(participant, topic, options.reader_profile_for(transport), log,
@@ -574,7 +577,7 @@ json run_fastdds(const BenchOptions& options, const Transport& transport) {
 }
 
 json run_writer_role(const BenchOptions& options, const Transport& transport) {
-  Participant participant(options.domain, std::string(transport.participant_profile));
+  dds::Participant participant(options.domain, std::string(transport.participant_profile));
   fdds::DataWriter* writer = participant.publisher()->create_datawriter_with_profile(
       participant.robot_state_topic(options.topic), options.writer_profile);
   require(writer != nullptr, "cannot create a writer with profile '" + options.writer_profile + "'");

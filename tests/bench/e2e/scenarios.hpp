@@ -63,7 +63,7 @@ nlohmann::json run_gateway_ros2_standard(const BenchOptions& options, double ros
 nlohmann::json run_max_rate(const BenchOptions& options, const Transport& transport,
                             const std::vector<double>& rates);
 
-/// rsg::EmbeddedGateway in this process: frames over UDP to it, latency at its callback (the
+/// rsg::gateway::EmbeddedGateway in this process: frames over UDP to it, latency at its callback (the
 /// controller's view), and at the same time at a DDS reader of another participant over UDP.
 nlohmann::json run_embedded(const BenchOptions& options);
 

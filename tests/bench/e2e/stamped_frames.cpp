@@ -9,8 +9,9 @@
 namespace rsg::bench {
 namespace {
 
-constexpr Field kStampField = Field::elbow_d;
-static_assert(info(kStampField).type == ElementType::kFloat64 && info(kStampField).count == 2);
+constexpr wire::Field kStampField = wire::Field::elbow_d;
+static_assert(wire::info(kStampField).type == wire::ElementType::kFloat64 &&
+              wire::info(kStampField).count == 2);
 // Field bytes are little-endian doubles; reading them in place assumes the host agrees.
 static_assert(std::endian::native == std::endian::little);
 
@@ -23,35 +24,35 @@ Stamp stamp_of(double index, double sent_ns) {
 }  // namespace
 
 StampedFrames::StampedFrames() {
-  values_.selection = Selection::all();
+  values_.selection = wire::Selection::all();
   // Distinct, finite values per field and element: any double will do, the codec does not care.
-  for (const FieldInfo& field : kFields) {
-    if (field.type != ElementType::kFloat64) continue;
+  for (const wire::FieldInfo& field : wire::kFields) {
+    if (field.type != wire::ElementType::kFloat64) continue;
     std::span<double> elements = values_.doubles(field.id());
     for (std::size_t i = 0; i < elements.size(); ++i)
       elements[i] = field.index + 0.001 * static_cast<double>(i);
   }
-  values_.set_integer(Field::robot_mode, kRobotModeMove);
+  values_.set_integer(wire::Field::robot_mode, kRobotModeMove);
 }
 
 void StampedFrames::stamp_now(std::uint64_t index) {
-  values_.packet_number = static_cast<std::uint8_t>(index % kPacketNumberModulo);
-  values_.set_integer(Field::time, index);
+  values_.packet_number = static_cast<std::uint8_t>(index % wire::kPacketNumberModulo);
+  values_.set_integer(wire::Field::time, index);
   std::span<double> stamp = values_.doubles(kStampField);
   stamp[0] = static_cast<double>(index);
   stamp[1] = static_cast<double>(monotonic_ns());
 }
 
 std::span<const std::uint8_t> StampedFrames::encode() {
-  const EncodeResult encoded =
-      rsg::encode(values_.packet_number, values_.selection, values_.storage(), StateValues::layout(), frame_);
+  const wire::EncodeResult encoded = rsg::wire::encode(
+      values_.packet_number, values_.selection, values_.storage(), wire::StateValues::layout(), frame_);
   if (!encoded) throw std::logic_error("the bench's own frame does not encode");
   return std::span(frame_).first(encoded.size);
 }
 
-void StampedFrames::fill(RobotState& sample) const { to_sample(values_, sample); }
+void StampedFrames::fill(RobotState& sample) const { dds::to_sample(values_, sample); }
 
-std::optional<Stamp> read_stamp(const FrameView& frame) {
+std::optional<Stamp> read_stamp(const wire::FrameView& frame) {
   const std::span<const std::uint8_t> bytes = frame.field_bytes(kStampField);
   if (bytes.size() != 2 * sizeof(double)) return std::nullopt;
   std::array<double, 2> stamp{};

@@ -54,12 +54,12 @@ class StampedFrames {
   void fill(RobotState& sample) const;
 
  private:
-  StateValues values_;
-  std::array<std::uint8_t, kMaxFrameBytes> frame_{};
+  wire::StateValues values_;
+  std::array<std::uint8_t, wire::kMaxFrameBytes> frame_{};
 };
 
 /// The stamp of a frame that carries one.
-std::optional<Stamp> read_stamp(const FrameView& frame);
+std::optional<Stamp> read_stamp(const wire::FrameView& frame);
 Stamp read_stamp(const RobotState& sample);
 
 }  // namespace rsg::bench

@@ -9,6 +9,7 @@
 #include <thread>
 
 namespace rsg::bench {
+namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 constexpr auto kPollInterval = std::chrono::milliseconds(10);
@@ -25,7 +26,7 @@ bool poll_until(std::chrono::milliseconds timeout, Predicate done) {
 
 }  // namespace
 
-StateSubscriber::StateSubscriber(Participant& participant, const std::string& topic,
+StateSubscriber::StateSubscriber(dds::Participant& participant, const std::string& topic,
                                  const std::string& reader_profile, LatencyLog& log, bool waitset,
                                  LatencyLog* notified)
     : participant_(participant), log_(log), notified_(notified), subscriber_(participant.subscriber()) {

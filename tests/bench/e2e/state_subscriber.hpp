@@ -20,13 +20,13 @@
 
 namespace rsg::bench {
 
-class StateSubscriber : private fdds::DataReaderListener {
+class StateSubscriber : private eprosima::fastdds::dds::DataReaderListener {
  public:
   /// Creates the reader; `log` must outlive it. Samples are taken in the listener, or with
   /// `waitset` on a thread of this object's own that waits on a WaitSet (as rsg_echo does).
   /// `notified`, if given, gets each sample's time of entry into the listener (or of the
   /// WaitSet's wake-up), before take(). Throws std::runtime_error.
-  StateSubscriber(Participant& participant, const std::string& topic, const std::string& reader_profile,
+  StateSubscriber(dds::Participant& participant, const std::string& topic, const std::string& reader_profile,
                   LatencyLog& log, bool waitset = false, LatencyLog* notified = nullptr);
   ~StateSubscriber() override;
   StateSubscriber(const StateSubscriber&) = delete;
@@ -38,15 +38,15 @@ class StateSubscriber : private fdds::DataReaderListener {
   bool wait_for_all(std::chrono::milliseconds timeout) const;
 
  private:
-  void on_data_available(fdds::DataReader* reader) override;
-  void take_all(fdds::DataReader* reader, std::int64_t notified_ns);
+  void on_data_available(eprosima::fastdds::dds::DataReader* reader) override;
+  void take_all(eprosima::fastdds::dds::DataReader* reader, std::int64_t notified_ns);
 
-  Participant& participant_;
+  dds::Participant& participant_;
   LatencyLog& log_;
   LatencyLog* notified_;
-  fdds::Subscriber* subscriber_ = nullptr;
-  fdds::DataReader* reader_ = nullptr;
-  fdds::GuardCondition stop_;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
+  eprosima::fastdds::dds::GuardCondition stop_;
   std::thread waiting_;  // WaitSet mode only
 };
 

@@ -30,19 +30,19 @@ template <typename Write>
 void relay_frames(Write write) {
   std::signal(SIGTERM, [](int) { relay_stop = true; });
   std::signal(SIGINT, [](int) { relay_stop = true; });
-  UdpSocket socket = UdpSocket::bind(Endpoint::parse("127.0.0.1:0"));
+  transport::UdpSocket socket = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
   socket.set_receive_buffer(4 << 20);
   std::fprintf(stderr, "relay: frames on UDP %s -> DDS\n", socket.local_endpoint().to_string().c_str());
-  std::vector<std::uint8_t> datagram(kMaxFrameBytes);
+  std::vector<std::uint8_t> datagram(wire::kMaxFrameBytes);
   std::ptrdiff_t elbow_d = -1, time = -1;
   while (!relay_stop) {
     const auto size = socket.receive(datagram, nullptr, std::chrono::milliseconds(100));
     if (!size) continue;
     if (elbow_d < 0) {
-      const DecodeResult first = decode(std::span(datagram).first(*size));
+      const wire::DecodeResult first = wire::decode(std::span(datagram).first(*size));
       if (!first) continue;
-      elbow_d = first.frame().field_bytes(Field::elbow_d).data() - datagram.data();
-      time = first.frame().field_bytes(Field::time).data() - datagram.data();
+      elbow_d = first.frame().field_bytes(wire::Field::elbow_d).data() - datagram.data();
+      time = first.frame().field_bytes(wire::Field::time).data() - datagram.data();
     }
     write(StampBytes{datagram.data() + elbow_d, datagram.data() + time});
   }

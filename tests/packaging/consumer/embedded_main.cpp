@@ -1,4 +1,4 @@
-// A controller outside rsg, built against the installed package: starts rsg::EmbeddedGateway on
+// A controller outside rsg, built against the installed package: starts rsg::gateway::EmbeddedGateway on
 // a port the kernel picks, sends it one frame and exits 0 when the callback saw that frame.
 //
 //   embedded_consumer PROFILES_DIR DOMAIN
@@ -16,20 +16,21 @@ int main(int argc, char** argv) {
   if (argc != 3) return std::puts("usage: embedded_consumer PROFILES_DIR DOMAIN"), 2;
   std::atomic<int> seen{0};
   std::atomic<double> q0{0};
-  rsg::EmbeddedGateway gateway("listen: 127.0.0.1:0\nlog-level: warn\nprofiles: " + std::string(argv[1]) +
-                                   "\ndomain: " + argv[2] + "\n",
-                               [&](const rsg::RobotState& state) {
-                                 q0 = state.q()[0];
-                                 ++seen;
-                               });
+  rsg::gateway::EmbeddedGateway gateway("listen: 127.0.0.1:0\nlog-level: warn\nprofiles: " +
+                                            std::string(argv[1]) + "\ndomain: " + argv[2] + "\n",
+                                        [&](const rsg::RobotState& state) {
+                                          q0 = state.q()[0];
+                                          ++seen;
+                                        });
 
-  rsg::StateValues values;
-  values.selection = rsg::Selection::all();
-  for (double& q : values.doubles(rsg::Field::q)) q = 0.5;
-  std::array<std::uint8_t, rsg::kMaxFrameBytes> frame{};
-  const auto encoded = rsg::encode(0, values.selection, values.storage(), rsg::StateValues::layout(), frame);
-  const rsg::Endpoint to = gateway.local_endpoint();
-  rsg::UdpSocket robot = rsg::UdpSocket::for_sending_to(to);
+  rsg::wire::StateValues values;
+  values.selection = rsg::wire::Selection::all();
+  for (double& q : values.doubles(rsg::wire::Field::q)) q = 0.5;
+  std::array<std::uint8_t, rsg::wire::kMaxFrameBytes> frame{};
+  const auto encoded =
+      rsg::wire::encode(0, values.selection, values.storage(), rsg::wire::StateValues::layout(), frame);
+  const rsg::transport::Endpoint to = gateway.local_endpoint();
+  rsg::transport::UdpSocket robot = rsg::transport::UdpSocket::for_sending_to(to);
   if (!encoded || !robot.send_to(std::span(frame.data(), encoded.size), to))
     return std::puts("send failed"), 1;
   for (int i = 0; i < 200 && seen == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));

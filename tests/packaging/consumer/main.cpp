@@ -12,28 +12,28 @@
 #include "rsg/wire/state_values.hpp"
 
 int main() {
-  rsg::StateValues values;
+  rsg::wire::StateValues values;
   values.packet_number = 5;
-  values.selection = rsg::Selection::all();
-  for (double& q : values.doubles(rsg::Field::q)) q = 0.25;
+  values.selection = rsg::wire::Selection::all();
+  for (double& q : values.doubles(rsg::wire::Field::q)) q = 0.25;
 
-  std::array<std::uint8_t, rsg::kMaxFrameBytes> frame{};
-  const auto encoded = rsg::encode(values.packet_number, values.selection, values.storage(),
-                                   rsg::StateValues::layout(), frame);
+  std::array<std::uint8_t, rsg::wire::kMaxFrameBytes> frame{};
+  const auto encoded = rsg::wire::encode(values.packet_number, values.selection, values.storage(),
+                                         rsg::wire::StateValues::layout(), frame);
   if (!encoded) return std::puts("encode failed"), 1;
 
-  const auto decoded = rsg::decode(std::span(frame.data(), encoded.size));
+  const auto decoded = rsg::wire::decode(std::span(frame.data(), encoded.size));
   if (!decoded) return std::puts("decode failed"), 1;
   rsg::RobotState sample;
-  rsg::to_sample(decoded.frame(), sample);
+  rsg::dds::to_sample(decoded.frame(), sample);
 
-  std::array<std::uint8_t, rsg::kMaxFrameBytes> again{};
-  const auto reencoded = rsg::to_frame(sample, again);
+  std::array<std::uint8_t, rsg::wire::kMaxFrameBytes> again{};
+  const auto reencoded = rsg::dds::to_frame(sample, again);
   if (!reencoded || reencoded.size != encoded.size ||
       std::memcmp(frame.data(), again.data(), encoded.size) != 0)
     return std::puts("round trip differs"), 1;
 
-  const auto endpoint = rsg::Endpoint::parse("127.0.0.1:1337");
+  const auto endpoint = rsg::transport::Endpoint::parse("127.0.0.1:1337");
   std::printf("consumer: %zu-byte frame round trip exact, q[0]=%g, endpoint %s\n", encoded.size,
               sample.q()[0], endpoint.to_string().c_str());
   return 0;

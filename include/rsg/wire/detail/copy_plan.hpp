@@ -17,7 +17,7 @@
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/selection.hpp"
 
-namespace rsg {
+namespace rsg::wire {
 
 /// Frame bytes [frame_begin, frame_end) correspond to the struct bytes at the same offsets plus
 /// `struct_delta`. Offsets count from the start of the frame, header included.
@@ -98,4 +98,4 @@ class ChunkedCopyPlan {
   static_assert(kMaxChunks <= 64, "whole_chunks_ has a bit per chunk");
 };
 
-}  // namespace rsg
+}  // namespace rsg::wire
