@@ -4,6 +4,8 @@
 
 #include <stdexcept>
 
+#include "rsg/error.hpp"
+
 namespace rsg::capture {
 
 void PcapReader::Close::operator()(pcap* handle) const { pcap_close(handle); }
@@ -23,13 +25,13 @@ PcapReader::PcapReader(std::FILE* stream) {
 
 void PcapReader::start(pcap* handle, const std::string& name, const char* error) {
   name_ = name;
-  if (handle == nullptr) throw std::runtime_error("cannot read '" + name + "': " + error);
+  if (handle == nullptr) throw InputError("cannot read '" + name + "': " + error);
   handle_.reset(handle);
   linktype_ = pcap_datalink(handle);
   if (!UdpExtractor::supports(linktype_)) {
     const char* link_name = pcap_datalink_val_to_name(linktype_);
-    throw std::runtime_error("'" + name + "': link type " + (link_name ? link_name : "?") + " (" +
-                             std::to_string(linktype_) + ") is not supported");
+    throw InputError("'" + name + "': link type " + (link_name ? link_name : "?") + " (" +
+                     std::to_string(linktype_) + ") is not supported");
   }
   extractor_.emplace(linktype_);
 }
@@ -41,7 +43,7 @@ std::optional<UdpPacket> PcapReader::next() {
     const int status = pcap_next_ex(handle_.get(), &header, &bytes);
     if (status == PCAP_ERROR_BREAK) return std::nullopt;  // end of file
     if (status != 1)
-      throw std::runtime_error("'" + name_ + "' is damaged: " + std::string(pcap_geterr(handle_.get())));
+      throw InputError("'" + name_ + "' is damaged: " + std::string(pcap_geterr(handle_.get())));
     const std::chrono::nanoseconds time =
         std::chrono::seconds(header->ts.tv_sec) + std::chrono::nanoseconds(header->ts.tv_usec);
     if (auto packet = extractor_->extract(time, {bytes, header->caplen})) return packet;
@@ -53,10 +55,10 @@ void PcapWriter::Close::operator()(pcap_dumper* dumper) const { pcap_dump_close(
 
 PcapWriter::PcapWriter(const std::string& path)
     : path_(path), dead_(pcap_open_dead(DLT_RAW, static_cast<int>(kMaxIpUdpHeader + kMaxUdpPayload))) {
-  if (!dead_) throw std::runtime_error("cannot write '" + path + "': libpcap refused raw IP");
+  if (!dead_) throw EnvironmentError("cannot write '" + path + "': libpcap refused raw IP");
   dumper_.reset(pcap_dump_open(dead_.get(), path.c_str()));
   if (!dumper_)
-    throw std::runtime_error("cannot write '" + path + "': " + std::string(pcap_geterr(dead_.get())));
+    throw EnvironmentError("cannot write '" + path + "': " + std::string(pcap_geterr(dead_.get())));
 }
 
 bool PcapWriter::write(const UdpPacket& packet) {
@@ -73,7 +75,7 @@ bool PcapWriter::write(const UdpPacket& packet) {
 
 void PcapWriter::flush() {
   if (pcap_dump_flush(dumper_.get()) != 0 || std::ferror(pcap_dump_file(dumper_.get())))
-    throw std::runtime_error("cannot write '" + path_ + "'");
+    throw EnvironmentError("cannot write '" + path_ + "'");
 }
 
 }  // namespace rsg::capture

@@ -8,6 +8,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "rsg/error.hpp"
+
 namespace rsg::capture {
 namespace {
 
@@ -188,8 +190,7 @@ bool UdpExtractor::supports(int linktype) {
 }
 
 UdpExtractor::UdpExtractor(int linktype) : linktype_(linktype) {
-  if (!supports(linktype))
-    throw std::invalid_argument("link type " + std::to_string(linktype) + " is not supported");
+  if (!supports(linktype)) throw InputError("link type " + std::to_string(linktype) + " is not supported");
 }
 
 std::optional<UdpPacket> UdpExtractor::extract(std::chrono::nanoseconds time,

@@ -8,6 +8,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include "rsg/error.hpp"
+
 namespace rsg::dds {
 namespace {
 
@@ -20,8 +22,7 @@ std::string resolve_ipv4(const std::string& host, const std::string& value) {
   hints.ai_socktype = SOCK_DGRAM;
   addrinfo* found = nullptr;
   if (const int status = ::getaddrinfo(host.c_str(), nullptr, &hints, &found); status != 0)
-    throw std::invalid_argument("'" + value + "': cannot resolve '" + host +
-                                "' to IPv4: " + gai_strerror(status));
+    throw InputError("'" + value + "': cannot resolve '" + host + "' to IPv4: " + gai_strerror(status));
   const std::unique_ptr<addrinfo, decltype(&::freeaddrinfo)> owner(found, &::freeaddrinfo);
   char text[INET_ADDRSTRLEN] = {};
   ::inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(found->ai_addr)->sin_addr, text, sizeof text);
@@ -41,10 +42,10 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
   auto& builtin = qos.wire_protocol().builtin;
   for (std::size_t index = 0; index < options.servers.size(); ++index) {
     const std::string& value = options.servers[index];
-    auto id = static_cast<unsigned>(index);
-    transport::HostPort server;
-    if (auto error = transport::split_discovery_server(value, id, server); !error.empty())
-      throw std::invalid_argument(error);
+    const wire::Parsed<transport::DiscoveryServer> parsed = transport::parse_discovery_server(value);
+    if (!parsed) throw InputError(parsed.error());
+    const unsigned id = parsed->id.value_or(static_cast<unsigned>(index));
+    const transport::HostPort& server = parsed->address;
     eprosima::fastdds::rtps::RemoteServerAttributes remote;
     eprosima::fastdds::rtps::get_server_client_default_guidPrefix(static_cast<int>(id), remote.guidPrefix);
     remote.metatrafficUnicastLocatorList.push_back(
@@ -70,10 +71,9 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
 
   const auto& ports = qos.wire_protocol().port;
   for (const std::string& value : options.peers) {
-    transport::HostPort peer;
-    if (auto error = transport::split_host_port(value, transport::HostPortRule::kPortOptional, peer);
-        !error.empty())
-      throw std::invalid_argument(error);
+    const wire::Parsed<transport::HostPort> parsed = transport::parse_peer(value);
+    if (!parsed) throw InputError(parsed.error());
+    const transport::HostPort& peer = *parsed;
     const std::string address = resolve_ipv4(peer.host, value);
     if (peer.port != 0) {
       builtin.initialPeersList.push_back(udp_locator(address, peer.port));

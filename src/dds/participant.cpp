@@ -7,6 +7,8 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <stdexcept>
 
+#include "rsg/error.hpp"
+
 namespace rsg::dds {
 namespace fdds = eprosima::fastdds::dds;
 
@@ -15,8 +17,8 @@ Participant::Participant(int domain, const std::string& profile) {
   participant_ = profile.empty() ? factory->create_participant(domain, fdds::PARTICIPANT_QOS_DEFAULT)
                                  : factory->create_participant_with_profile(domain, profile);
   if (!participant_)
-    throw std::runtime_error("cannot create DDS participant on domain " + std::to_string(domain) +
-                             " with profile '" + profile + "' (are the XML profiles loaded?)");
+    throw EnvironmentError("cannot create DDS participant on domain " + std::to_string(domain) +
+                           " with profile '" + profile + "' (are the XML profiles loaded?)");
 }
 
 namespace {
@@ -26,7 +28,7 @@ fdds::DomainParticipantQos profile_qos(const std::string& profile) {
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   if (profile.empty()) return factory->get_default_participant_qos();
   if (factory->get_participant_qos_from_profile(profile, qos) != ReturnCode_t::RETCODE_OK)
-    throw std::runtime_error("no participant profile named '" + profile + "' (are the XML profiles loaded?)");
+    throw InputError("no participant profile named '" + profile + "' (are the XML profiles loaded?)");
   return qos;
 }
 
@@ -44,7 +46,7 @@ Participant::Participant(int domain, const std::string& profile, const Discovery
 Participant::Participant(int domain, const fdds::DomainParticipantQos& qos) {
   participant_ = fdds::DomainParticipantFactory::get_instance()->create_participant(domain, qos);
   if (!participant_)
-    throw std::runtime_error("cannot create DDS participant on domain " + std::to_string(domain));
+    throw EnvironmentError("cannot create DDS participant on domain " + std::to_string(domain));
 }
 
 Participant::~Participant() {
@@ -57,9 +59,9 @@ fdds::Topic* Participant::topic(const std::string& name, fdds::TypeSupport type)
   type->auto_fill_type_information(false);
   type->auto_fill_type_object(false);
   if (participant_->register_type(type) != ReturnCode_t::RETCODE_OK)
-    throw std::runtime_error("cannot register type " + type.get_type_name());
+    throw EnvironmentError("cannot register type " + type.get_type_name());
   fdds::Topic* created = participant_->create_topic(name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
-  if (!created) throw std::runtime_error("cannot create topic '" + name + "'");
+  if (!created) throw EnvironmentError("cannot create topic '" + name + "'");
   return created;
 }
 
@@ -80,7 +82,7 @@ fdds::Publisher* Participant::publisher(const std::vector<std::string>& partitio
   fdds::PublisherQos qos = participant_->get_default_publisher_qos();
   for (const auto& partition : partitions) qos.partition().push_back(partition.c_str());
   fdds::Publisher* created = participant_->create_publisher(qos);
-  if (!created) throw std::runtime_error("cannot create DDS publisher");
+  if (!created) throw EnvironmentError("cannot create DDS publisher");
   return created;
 }
 
@@ -88,7 +90,7 @@ fdds::Subscriber* Participant::subscriber(const std::vector<std::string>& partit
   fdds::SubscriberQos qos = participant_->get_default_subscriber_qos();
   for (const auto& partition : partitions) qos.partition().push_back(partition.c_str());
   fdds::Subscriber* created = participant_->create_subscriber(qos);
-  if (!created) throw std::runtime_error("cannot create DDS subscriber");
+  if (!created) throw EnvironmentError("cannot create DDS subscriber");
   return created;
 }
 

@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "rsg/error.hpp"
+
 namespace rsg::dds {
 namespace {
 
@@ -44,12 +46,12 @@ void load_profiles(const std::filesystem::path& file_or_dir) {
   } else if (std::filesystem::is_regular_file(file_or_dir, error)) {
     files.push_back(file_or_dir);
   }
-  if (files.empty()) throw std::runtime_error(file_or_dir.string() + ": no XML profiles found");
+  if (files.empty()) throw InputError(file_or_dir.string() + ": no XML profiles found");
   auto* factory = eprosima::fastdds::dds::DomainParticipantFactory::get_instance();
   for (const auto& file : files)
     if (factory->load_XML_profiles_file(file.string()) != ReturnCode_t::RETCODE_OK)
-      throw std::runtime_error(file.string() +
-                               ": Fast DDS rejected this XML profile file (its log above says where)");
+      throw InputError(file.string() +
+                       ": Fast DDS rejected this XML profile file (its log above says where)");
 }
 
 void load_profiles(const std::vector<std::string>& files_or_dirs, const std::string& participant_profile) {
@@ -58,7 +60,7 @@ void load_profiles(const std::vector<std::string>& files_or_dirs, const std::str
   eprosima::fastdds::dds::DomainParticipantQos unused;
   if (eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
           participant_profile, unused) != ReturnCode_t::RETCODE_OK)
-    throw std::runtime_error("no participant profile named '" + participant_profile + "'");
+    throw InputError("no participant profile named '" + participant_profile + "'");
 }
 
 }  // namespace rsg::dds

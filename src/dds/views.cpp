@@ -4,6 +4,7 @@
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 
+#include "rsg/error.hpp"
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/selection.hpp"
 
@@ -30,8 +31,8 @@ fdds::ContentFilteredTopic* find_or_create_filtered_topic(fdds::DomainParticipan
   if (existing == nullptr) {
     fdds::ContentFilteredTopic* created = participant.create_contentfilteredtopic(name, &topic, filter, {});
     if (created == nullptr)
-      throw std::runtime_error("cannot create the filtered topic '" + name + "' with filter \"" + filter +
-                               "\" (is the RobotState type object registered?)");
+      throw ViewError("cannot create the filtered topic '" + name + "' with filter \"" + filter +
+                      "\" (a DDS-SQL expression over RobotState's members?)");
     return created;
   }
   auto* filtered = dynamic_cast<fdds::ContentFilteredTopic*>(existing);
@@ -76,11 +77,9 @@ View parse_view(const std::string& profile, const fdds::DataReaderQos& qos) {
     if (filter->empty()) throw ViewError(where + kViewFilterProperty + " is empty");
     return View{.name = profile, .groups = 0, .filter = *filter};
   }
-  std::uint8_t mask = 0;
-  std::string error;
-  if (!wire::parse_group_mask(*groups, mask, error))
-    throw ViewError(where + kViewGroupsProperty + " = \"" + *groups + "\": " + error);
-  return View{.name = profile, .groups = mask, .filter = group_filter_expression(mask)};
+  const wire::Parsed<std::uint8_t> mask = wire::parse_group_mask(*groups);
+  if (!mask) throw ViewError(where + kViewGroupsProperty + " = \"" + *groups + "\": " + mask.error());
+  return View{.name = profile, .groups = *mask, .filter = group_filter_expression(*mask)};
 }
 
 fdds::DataReaderQos load_reader_qos(const fdds::Subscriber& subscriber, const std::string& profile) {
@@ -107,13 +106,13 @@ ViewReader::ViewReader(fdds::Subscriber& subscriber, fdds::Topic& topic, View vi
     : subscriber_(subscriber), view_(std::move(view)) {
   fdds::DomainParticipant& participant = *topic.get_participant();
   if (subscriber.get_participant() != &participant)
-    throw std::invalid_argument("ViewReader: subscriber and topic belong to different participants");
+    throw std::logic_error("ViewReader: subscriber and topic belong to different participants");
   const std::string name = topic.get_name() + "/" + view_.name;
   filtered_topic_ = find_or_create_filtered_topic(participant, topic, name, view_.filter);
   reader_ = subscriber.create_datareader(filtered_topic_, qos, listener, mask);
   if (reader_ == nullptr) {
     participant.delete_contentfilteredtopic(filtered_topic_);  // refused while another reader uses it
-    throw std::runtime_error("cannot create a reader on '" + name + "' (inconsistent reader QoS?)");
+    throw EnvironmentError("cannot create a reader on '" + name + "' (inconsistent reader QoS?)");
   }
 }
 

@@ -23,8 +23,7 @@ std::string join(const std::vector<std::string>& items) {
 
 // Syntax only (rsg/transport/host_port.hpp): names are resolved when the gateway starts.
 std::string check_host_port(const std::string& value, transport::HostPortRule rule) {
-  transport::HostPort parsed;
-  return transport::split_host_port(value, rule, parsed);
+  return transport::parse_host_port(value, rule).error();
 }
 
 std::string check_optional_host_port(const std::string& value) {
@@ -33,9 +32,11 @@ std::string check_optional_host_port(const std::string& value) {
 
 std::string check_not_empty(const std::string& value) { return value.empty() ? "must not be empty" : ""; }
 
-std::string check_each(const std::vector<std::string>& values, std::string (*check)(const std::string&)) {
+// The first complaint of `parse` (a parser returning wire::Parsed) about one of `values`, or "".
+template <class Parse>
+std::string check_each(const std::vector<std::string>& values, Parse parse) {
   for (const auto& value : values)
-    if (auto error = check(value); !error.empty()) return error;
+    if (auto parsed = parse(value); !parsed) return parsed.error();
   return {};
 }
 
@@ -103,22 +104,15 @@ const std::array kKeys = {
         &GatewayConfig::robot, [](const GatewayConfig& c) { return check_optional_host_port(c.robot); }},
     ConfigKey{"request-groups", "Ask the robot for these groups, e.g. 2,5", &GatewayConfig::request_groups,
               [](const GatewayConfig& c) {
-                wire::Selection ignored;
-                std::string error;
-                return c.request_groups.empty() ||
-                               wire::parse_group_list(join(c.request_groups), ignored, error)
-                           ? std::string()
-                           : error;
+                return c.request_groups.empty() ? std::string()
+                                                : wire::parse_group_list(join(c.request_groups)).error();
               }},
-    ConfigKey{
-        "request-fields", "Ask the robot for these fields, e.g. q,dq,time", &GatewayConfig::request_fields,
-        [](const GatewayConfig& c) {
-          wire::Selection ignored;
-          std::string error;
-          return c.request_fields.empty() || wire::parse_field_list(join(c.request_fields), ignored, error)
-                     ? std::string()
-                     : error;
-        }},
+    ConfigKey{"request-fields", "Ask the robot for these fields, e.g. q,dq,time",
+              &GatewayConfig::request_fields,
+              [](const GatewayConfig& c) {
+                return c.request_fields.empty() ? std::string()
+                                                : wire::parse_field_list(join(c.request_fields)).error();
+              }},
     ConfigKey{"status-topic", "Topic of the GatewayStatus samples", &GatewayConfig::status_topic,
               [](const GatewayConfig& c) { return check_not_empty(c.status_topic); }},
     ConfigKey{"expected-rate",
@@ -182,7 +176,7 @@ const std::array kKeys = {
               &GatewayConfig::ros2_namespace,
               [](const GatewayConfig& c) {
                 if (!c.ros2_namespace.empty() && !c.ros2) return std::string("needs --ros2");
-                return dds::check_ros2_namespace(c.ros2_namespace);
+                return dds::parse_ros2_namespace(c.ros2_namespace).error();
               }},
     ConfigKey{
         "joint-states",
@@ -226,10 +220,10 @@ const std::array kKeys = {
               [](const GatewayConfig& c) { return check_not_empty(c.status_profile); }},
     ConfigKey{"discovery-server", transport::kDiscoveryServerHelp, &GatewayConfig::discovery_servers,
               [](const GatewayConfig& c) {
-                return check_each(c.discovery_servers, transport::check_discovery_server);
+                return check_each(c.discovery_servers, transport::parse_discovery_server);
               }},
     ConfigKey{"peer", transport::kPeerHelp, &GatewayConfig::peers,
-              [](const GatewayConfig& c) { return check_each(c.peers, transport::check_peer); }},
+              [](const GatewayConfig& c) { return check_each(c.peers, transport::parse_peer); }},
 };
 
 const ConfigKey* find_key(std::string_view name) {
@@ -385,12 +379,11 @@ std::optional<Decimation> parse_decimation(const std::string& value) {
 }
 
 wire::Selection requested_selection(const GatewayConfig& config) {
+  // Both lists were checked with the configuration.
   wire::Selection selection;
-  std::string ignored;
-  if (!config.request_groups.empty()) wire::parse_group_list(join(config.request_groups), selection, ignored);
+  if (!config.request_groups.empty()) selection = *wire::parse_group_list(join(config.request_groups));
   if (!config.request_fields.empty()) {
-    wire::Selection fields;
-    wire::parse_field_list(join(config.request_fields), fields, ignored);
+    const wire::Selection fields = *wire::parse_field_list(join(config.request_fields));
     for (const wire::FieldInfo& field : wire::kFields)
       if (fields.contains(field.id())) selection.add(field.id());
   }

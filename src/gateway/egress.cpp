@@ -8,6 +8,7 @@
 
 #include "ros2_type_hash.hpp"
 #include "rsg/dds/robot_state.hpp"
+#include "rsg/error.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;
@@ -22,14 +23,10 @@ Egress::Egress(dds::Participant& participant, const Options& options) : particip
   for (const transport::Endpoint& endpoint : options.destinations)
     destinations_.push_back({endpoint, transport::UdpSocket::for_sending_to(endpoint)});
 
-  subscriber_ = participant_.subscriber(options.partitions);
+  subscriber_ = dds::own(participant_, participant_.subscriber(options.partitions));
   fdds::Topic* topic = participant_.robot_state_topic(options.topic, options.type_name);
-  reader_ = create_reader_with_profile(*subscriber_, topic, options.reader_profile);
-  if (!reader_) {
-    participant_.get()->delete_subscriber(subscriber_);
-    throw std::runtime_error("cannot create the RobotState reader with profile '" + options.reader_profile +
-                             "'");
-  }
+  reader_ = dds::own(*subscriber_, create_reader_with_profile(*subscriber_, topic, options.reader_profile),
+                     "the RobotState reader with profile '" + options.reader_profile + "'");
   reader_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
   waitset_.attach_condition(reader_->get_statuscondition());
   waitset_.attach_condition(stop_);
@@ -41,9 +38,7 @@ Egress::~Egress() {
   thread_.join();
   waitset_.detach_condition(stop_);
   waitset_.detach_condition(reader_->get_statuscondition());
-  subscriber_->delete_datareader(reader_);
-  participant_.get()->delete_subscriber(subscriber_);
-}
+}  // the owners delete the reader, then the subscriber
 
 EgressCounters Egress::counters() const {
   return {samples_.load(std::memory_order_relaxed), frames_sent_.load(std::memory_order_relaxed),

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "log_throttle.hpp"
+#include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/transport/udp_socket.hpp"
@@ -58,8 +59,8 @@ class Egress {
   void log_unencodable();
 
   dds::Participant& participant_;
-  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
-  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
+  dds::OwnedSubscriber subscriber_;
+  dds::OwnedReader reader_;
   std::vector<Destination> destinations_;
   std::array<std::uint8_t, wire::kMaxFrameBytes> frame_{};
   dds::RobotStateCodec codec_;  // used by the forwarding thread only

@@ -8,6 +8,7 @@
 
 #include "config.hpp"
 #include "gateway.hpp"
+#include "rsg/error.hpp"
 
 namespace rsg::gateway {
 namespace {
@@ -18,17 +19,17 @@ gateway::GatewaySetup prepare_embedded(std::string_view yaml_config,
   const gateway::ConfigResult parsed = gateway::parse_gateway_config(yaml_config);
   if (!parsed) {
     const auto& error = parsed.error();
-    throw std::invalid_argument("embedded gateway configuration" +
-                                (error.line > 0 ? ", line " + std::to_string(error.line) : std::string()) +
-                                ": " + error.message);
+    throw InputError("embedded gateway configuration" +
+                     (error.line > 0 ? ", line " + std::to_string(error.line) : std::string()) + ": " +
+                     error.message);
   }
   if (!parsed.config().has_ingress())
-    throw std::invalid_argument("embedded gateway configuration: `listen` is required");
+    throw InputError("embedded gateway configuration: `listen` is required");
   gateway::GatewaySetup setup;
   try {
     setup = gateway::prepare(parsed.config());
-  } catch (const std::runtime_error& error) {
-    throw std::invalid_argument(std::string("embedded gateway configuration: ") + error.what());
+  } catch (const InputError& error) {
+    throw InputError(std::string("embedded gateway configuration: ") + error.what());
   }
   setup.ingress->on_sample = std::move(on_sample);
   return setup;

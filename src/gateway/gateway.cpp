@@ -18,6 +18,7 @@
 #include "rsg/dds/discovery.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/ros2.hpp"
+#include "rsg/error.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;
@@ -35,8 +36,8 @@ constexpr milliseconds kLongestWait{100};
 transport::Endpoint resolve(const std::string& flag, const std::string& host_port) {
   try {
     return transport::Endpoint::parse(host_port);
-  } catch (const std::invalid_argument& error) {
-    throw std::runtime_error("--" + flag + ": " + error.what());
+  } catch (const InputError& error) {
+    throw InputError("--" + flag + ": " + error.what());
   }
 }
 
@@ -50,8 +51,7 @@ void load_and_check_profiles(const GatewayConfig& config) {
   eprosima::fastrtps::PublisherAttributes writer;
   eprosima::fastrtps::SubscriberAttributes reader;
   const auto require = [&](bool found, const std::string& kind, const std::string& name) {
-    if (!found)
-      throw std::runtime_error(profiles.string() + ": no " + kind + " profile named '" + name + "'");
+    if (!found) throw InputError(profiles.string() + ": no " + kind + " profile named '" + name + "'");
   };
   require(XMLProfiles::fillParticipantAttributes(config.participant_profile, participant, false) ==
               XMLP_ret::XML_OK,
@@ -76,14 +76,14 @@ fdds::DomainParticipantQos participant_qos(const GatewayConfig& config) {
   fdds::DomainParticipantQos qos;
   if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(profile, qos) !=
       ReturnCode_t::RETCODE_OK)
-    throw std::runtime_error("no participant profile named '" + profile + "'");
+    throw InputError("no participant profile named '" + profile + "'");
   if (qos.wire_protocol().participant_id < 0)
     qos.wire_protocol().participant_id =
         static_cast<std::int32_t>(::getpid() % transport::kGatewayParticipantIds);
   try {
     dds::apply_discovery({config.discovery_servers, config.peers}, config.domain, qos);
-  } catch (const std::invalid_argument& error) {
-    throw std::runtime_error(std::string("--discovery-server/--peer: ") + error.what());
+  } catch (const InputError& error) {
+    throw InputError(std::string("--discovery-server/--peer: ") + error.what());
   }
   return qos;
 }
@@ -127,7 +127,7 @@ std::optional<Ros2StandardTopics::Options> standard_topics_of(const GatewayConfi
 }  // namespace
 
 GatewaySetup prepare(const GatewayConfig& config) {
-  if (auto problem = check_config(config)) throw std::runtime_error(*problem);
+  if (auto problem = check_config(config)) throw InputError(*problem);
 
   GatewaySetup setup{config, std::nullopt, std::nullopt};
   if (config.has_ingress()) {
@@ -136,7 +136,7 @@ GatewaySetup prepare(const GatewayConfig& config) {
     ingress.receive_buffer = config.receive_buffer;
     for (const auto& network : config.allow_from) {
       std::string error;
-      if (!ingress.sources.allow(network, error)) throw std::runtime_error("--allow-from: " + error);
+      if (!ingress.sources.allow(network, error)) throw InputError("--allow-from: " + error);
     }
     ingress.topic = dds_topic(config, config.topic);
     ingress.type_name = state_type_name(config);
@@ -155,7 +155,7 @@ GatewaySetup prepare(const GatewayConfig& config) {
     if (config.pcap_ring > 0) {
       std::error_code error;
       if (!std::filesystem::is_directory(config.pcap_dir, error))
-        throw std::runtime_error("--pcap-dir: '" + config.pcap_dir + "' is not a directory");
+        throw InputError("--pcap-dir: '" + config.pcap_dir + "' is not a directory");
       ingress.flight_recorder = FlightRecorder::Options{std::chrono::duration<double>(config.pcap_ring),
                                                         config.expected_rate, config.pcap_dir};
     }

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "ros2_type_hash.hpp"
+#include "rsg/error.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;
@@ -79,44 +80,27 @@ Ingress::Ingress(dds::Participant& participant, Options options)
                  options_.flight_recorder->dir.string());
   }
 
-  publisher_ = participant_.publisher(options_.partitions);
+  // Should anything below throw, the owners built so far delete their entities.
+  publisher_ = dds::own(participant_, participant_.publisher(options_.partitions));
   fdds::Topic* topic = participant_.robot_state_topic(options_.topic, options_.type_name);
-  writer_ = create_writer_with_profile(*publisher_, topic, options_.writer_profile);
-  if (!writer_) {
-    participant_.get()->delete_publisher(publisher_);
-    throw std::runtime_error("cannot create the RobotState writer with profile '" + options_.writer_profile +
-                             "'");
-  }
+  writer_ = dds::own(*publisher_, create_writer_with_profile(*publisher_, topic, options_.writer_profile),
+                     "the RobotState writer with profile '" + options_.writer_profile + "'");
   for (const auto& rate : options_.rate_topics) {
     fdds::Topic* rate_topic = participant_.robot_state_topic(rate.topic, options_.type_name);
-    fdds::DataWriter* rate_writer =
-        create_writer_with_profile(*publisher_, rate_topic, options_.writer_profile);
-    if (!rate_writer) {
-      publisher_->delete_contained_entities();
-      participant_.get()->delete_publisher(publisher_);
-      throw std::runtime_error("cannot create the writer of --rate-topic '" + rate.topic + "'");
-    }
-    rate_writers_.push_back({rate_writer, Decimator(rate.rate)});
+    rate_writers_.push_back(
+        {dds::own(*publisher_, create_writer_with_profile(*publisher_, rate_topic, options_.writer_profile),
+                  "the writer of --rate-topic '" + rate.topic + "'"),
+         Decimator(rate.rate)});
   }
-  if (options_.standard_topics && options_.standard_topics->any()) {
-    try {
-      standard_topics_.emplace(participant_, *publisher_, *options_.standard_topics);
-    } catch (...) {
-      publisher_->delete_contained_entities();
-      participant_.get()->delete_publisher(publisher_);
-      throw;
-    }
-  }
+  if (options_.standard_topics && options_.standard_topics->any())
+    standard_topics_.emplace(participant_, *publisher_, *options_.standard_topics);
   // Loans need a plain type; RobotState is one, but a profile could still make writes non-loanable.
   writer_loans_ = writer_->get_type()->is_plain();
 }
 
-Ingress::~Ingress() {
-  standard_topics_.reset();  // its thread writes until then
-  for (const RateWriter& rate : rate_writers_) publisher_->delete_datawriter(rate.writer);
-  publisher_->delete_datawriter(writer_);
-  participant_.get()->delete_publisher(publisher_);
-}
+// The members' owners delete the standard topics' writers (after their thread), the rate writers,
+// the writer and the publisher, in that order.
+Ingress::~Ingress() = default;
 
 void Ingress::start(Clock::time_point now) {
   if (requester_ && options_.robot && requester_->start_up_due(now)) request_selection(*options_.robot, now);

@@ -19,6 +19,7 @@
 #include "flight_recorder.hpp"
 #include "link_monitor.hpp"
 #include "ros2_standard_topics.hpp"
+#include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/transport/udp_socket.hpp"
@@ -109,18 +110,19 @@ class Ingress {
 
   // A downsampled writer: writes the frames its decimator takes.
   struct RateWriter {
-    eprosima::fastdds::dds::DataWriter* writer = nullptr;
+    dds::OwnedWriter writer;
     Decimator decimator;
   };
 
   Options options_;
   transport::UdpSocket socket_;
   dds::Participant& participant_;
-  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
+  // Owners: declared parent first, so that each goes before what created it.
+  dds::OwnedPublisher publisher_;
+  dds::OwnedWriter writer_;
   bool writer_loans_ = false;
   std::vector<RateWriter> rate_writers_;
-  std::optional<Ros2StandardTopics> standard_topics_;  // before publisher_ goes
+  std::optional<Ros2StandardTopics> standard_topics_;  // writes from its thread until destroyed
 
   // One frame per buffer: anything longer arrives marked truncated and is rejected unread.
   transport::DatagramBatch batch_;

@@ -1,8 +1,9 @@
 // rsg_gateway: raw SEND_BUF frames over UDP <-> RobotState DDS samples. See gateway.hpp.
 //
-// Exit status: 0 after SIGINT/SIGTERM, 2 when the configuration (flags, file, profiles) is
-// unusable or the gateway cannot start; nothing has been created by then. A refused real-time
-// setting (--rt-priority, --cpu) is a warning, not a failure.
+// Exit status (src/tools/tool_main.hpp, as every rsg executable): 0 after SIGINT/SIGTERM, 2 when the
+// configuration (flags, file, profiles, addresses) is unusable, 1 when the machine refuses (the port
+// is taken, DDS refuses an entity); nothing is left running then. A refused real-time setting
+// (--rt-priority, --cpu) is a warning, not a failure.
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -15,12 +16,14 @@
 
 #include "config.hpp"
 #include "gateway.hpp"
+#include "rsg/error.hpp"
+#include "tool_main.hpp"
 
 namespace {
 
 using rsg::gateway::GatewayConfig;
-
-constexpr int kExitUsage = 2;
+using rsg::tools::kExitOk;
+using rsg::tools::kExitUsage;
 
 constexpr const char* kRealtimeHelp = R"(Real-time mode applies to the ingress thread (the main thread):
   --rt-priority N  SCHED_FIFO at N needs CAP_SYS_NICE or `USER - rtprio N` in
@@ -75,7 +78,7 @@ void add_config_flags(CLI::App& app, GatewayConfig& config, std::string& config_
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot read");
+  if (!in) throw rsg::InputError(path + ": cannot read");
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();
@@ -103,12 +106,13 @@ std::optional<int> parse_command_line(int argc, char** argv, GatewayConfig& conf
   }
 
   std::string text;
-  try {
-    text = read_file(config_file);
-  } catch (const std::exception& error) {
-    std::cerr << "rsg_gateway: " << error.what() << '\n';
-    return kExitUsage;
-  }
+  if (const int status = rsg::tools::run_reporting_errors("rsg_gateway",
+                                                          [&] {
+                                                            text = read_file(config_file);
+                                                            return kExitOk;
+                                                          });
+      status != kExitOk)
+    return status;
   const rsg::gateway::ConfigResult parsed = rsg::gateway::parse_gateway_config(text);
   if (!parsed) {
     std::cerr << "rsg_gateway: " << config_file;
@@ -132,22 +136,12 @@ int main(int argc, char** argv) {
   spdlog::set_default_logger(spdlog::stderr_logger_mt("rsg_gateway"));
   spdlog::set_level(spdlog::level::from_str(config.log_level));
 
-  rsg::gateway::GatewaySetup setup;
-  try {
-    setup = rsg::gateway::prepare(config);
-  } catch (const std::exception& error) {
-    std::cerr << "rsg_gateway: " << error.what() << '\n';
-    return kExitUsage;
-  }
-
-  install_stop_handlers();
-  try {
+  return rsg::tools::run_reporting_errors("rsg_gateway", [&] {
+    const rsg::gateway::GatewaySetup setup = rsg::gateway::prepare(config);
+    install_stop_handlers();
     rsg::gateway::Gateway gateway(setup);
     rsg::gateway::enter_realtime_mode(config);
     gateway.run(stop_requested, &dump_requested);
-  } catch (const std::exception& error) {
-    spdlog::error("cannot start: {}", error.what());
-    return kExitUsage;
-  }
-  return 0;
+    return kExitOk;
+  });
 }

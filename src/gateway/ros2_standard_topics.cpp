@@ -10,6 +10,7 @@
 
 #include "ros2_type_hash.hpp"
 #include "rsg/dds/eigen.hpp"
+#include "rsg/error.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;
@@ -80,17 +81,12 @@ Ros2StandardTopics::Ros2StandardTopics(dds::Participant& participant, fdds::Publ
   messages_->tf.transforms()[0].child_frame_id(options_.ee_frame);
   messages_->wrench.header().frame_id(options_.wrench_frame);
   if (options_.joint_states && options_.joint_names.size() != 7)
-    throw std::runtime_error("joint_states needs 7 joint names");
-  try {
-    create(joint_states_, options_.joint_states,
-           fdds::TypeSupport(new sensor_msgs::msg::dds_::JointState_PubSubType()));
-    create(tf_, options_.tf, fdds::TypeSupport(new tf2_msgs::msg::dds_::TFMessage_PubSubType()));
-    create(wrench_, options_.external_wrench, fdds::TypeSupport(new geometry::WrenchStamped_PubSubType()));
-  } catch (...) {
-    for (Writer* writer : {&joint_states_, &tf_, &wrench_})
-      if (writer->writer) publisher_.delete_datawriter(writer->writer);
-    throw;
-  }
+    throw InputError("joint_states needs 7 joint names");
+  // Should a writer be refused, the ones created so far are deleted by their owners.
+  create(joint_states_, options_.joint_states,
+         fdds::TypeSupport(new sensor_msgs::msg::dds_::JointState_PubSubType()));
+  create(tf_, options_.tf, fdds::TypeSupport(new tf2_msgs::msg::dds_::TFMessage_PubSubType()));
+  create(wrench_, options_.external_wrench, fdds::TypeSupport(new geometry::WrenchStamped_PubSubType()));
   thread_ = std::thread([this] { run(); });
 }
 
@@ -99,17 +95,15 @@ Ros2StandardTopics::~Ros2StandardTopics() {
   wake_.fetch_add(1, std::memory_order_release);
   wake_.notify_one();
   thread_.join();
-  for (Writer* writer : {&joint_states_, &tf_, &wrench_})
-    if (writer->writer) publisher_.delete_datawriter(writer->writer);
-}
+}  // then the owners delete the writers
 
 void Ros2StandardTopics::create(Writer& writer, const std::optional<Output>& output, fdds::TypeSupport type) {
   if (!output) return;
   fdds::Topic* topic = participant_.topic(output->topic, type);
   fdds::DataWriterQos qos = writer_qos(publisher_);
   announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
-  writer.writer = publisher_.create_datawriter(topic, qos);
-  if (!writer.writer) throw std::runtime_error("cannot create the writer of '" + output->topic + "'");
+  writer.writer =
+      dds::own(publisher_, publisher_.create_datawriter(topic, qos), "the writer of '" + output->topic + "'");
   writer.decimator.emplace(output->decimation);
 }
 

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "decimator.hpp"
+#include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
 
@@ -81,7 +82,7 @@ class Ros2StandardTopics {
   };
 
   struct Writer {
-    eprosima::fastdds::dds::DataWriter* writer = nullptr;
+    dds::OwnedWriter writer;  // none when the output is off
     std::optional<Decimator> decimator;
     std::atomic<std::uint64_t> written{0};
   };

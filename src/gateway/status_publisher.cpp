@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "ros2_type_hash.hpp"
+#include "rsg/error.hpp"
 #include "status_sample.hpp"
 
 namespace rsg::gateway {
@@ -16,22 +17,16 @@ StatusPublisher::StatusPublisher(dds::Participant& participant, const std::strin
                                  const std::vector<std::string>& partitions, const std::string& profile,
                                  const std::string& type_name)
     : participant_(participant) {
-  publisher_ = participant_.publisher(partitions);
+  publisher_ = dds::own(participant_, participant_.publisher(partitions));
   // TypeSupport takes ownership of the type object it is given.
   fdds::TypeSupport type(new GatewayStatusPubSubType());
   if (!type_name.empty()) type->setName(type_name.c_str());
   fdds::Topic* status_topic = participant_.topic(topic, type);
-  writer_ = create_writer_with_profile(*publisher_, status_topic, profile);
-  if (!writer_) {
-    participant_.get()->delete_publisher(publisher_);
-    throw std::runtime_error("cannot create the GatewayStatus writer with profile '" + profile + "'");
-  }
+  writer_ = dds::own(*publisher_, create_writer_with_profile(*publisher_, status_topic, profile),
+                     "the GatewayStatus writer with profile '" + profile + "'");
 }
 
-StatusPublisher::~StatusPublisher() {
-  publisher_->delete_datawriter(writer_);
-  participant_.get()->delete_publisher(publisher_);
-}
+StatusPublisher::~StatusPublisher() = default;  // the owners delete the writer, then the publisher
 
 void StatusPublisher::publish(const GatewayStats& stats) {
   to_status_sample(stats, sample_);

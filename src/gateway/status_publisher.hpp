@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "stats.hpp"
 
@@ -26,8 +27,8 @@ class StatusPublisher {
 
  private:
   dds::Participant& participant_;
-  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
+  dds::OwnedPublisher publisher_;
+  dds::OwnedWriter writer_;
   GatewayStatus sample_;
 };
 

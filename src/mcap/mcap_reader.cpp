@@ -13,6 +13,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include "rsg/error.hpp"
+
 namespace rsg::mcap {
 namespace {
 
@@ -185,12 +187,12 @@ ScanResult scan(std::span<const std::uint8_t> file, RecordVisitor& visitor, cons
 
 MappedFile::MappedFile(const std::filesystem::path& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw std::runtime_error("cannot open " + path.string() + ": " + std::strerror(errno));
+  if (fd < 0) throw InputError("cannot open " + path.string() + ": " + std::strerror(errno));
   struct stat status {};
   if (::fstat(fd, &status) != 0) {
     const int error = errno;
     ::close(fd);
-    throw std::runtime_error("cannot stat " + path.string() + ": " + std::strerror(error));
+    throw InputError("cannot stat " + path.string() + ": " + std::strerror(error));
   }
   size_ = static_cast<std::size_t>(status.st_size);
   if (size_ > 0) {
@@ -198,7 +200,7 @@ MappedFile::MappedFile(const std::filesystem::path& path) {
     const int error = errno;
     ::close(fd);
     if (data == MAP_FAILED)
-      throw std::runtime_error("cannot map " + path.string() + ": " + std::strerror(error));
+      throw EnvironmentError("cannot map " + path.string() + ": " + std::strerror(error));
     data_ = static_cast<const std::uint8_t*>(data);
   } else {
     ::close(fd);

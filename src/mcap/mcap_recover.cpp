@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "rsg/error.hpp"
+
 namespace rsg::mcap {
 namespace {
 
@@ -58,7 +60,7 @@ RecoverResult recover(std::span<const std::uint8_t> damaged, const std::filesyst
   Copier copier(out, std::move(options));
   RecoverResult result;
   result.scan = scan(damaged, copier);
-  if (!copier.writer) throw std::runtime_error("not an MCAP file (no header): " + result.scan.error);
+  if (!copier.writer) throw InputError("not an MCAP file (no header): " + result.scan.error);
   copier.writer->close();
   result.written = copier.writer->totals();
   result.unreadable = copier.unreadable;

@@ -125,8 +125,7 @@ std::uint16_t Writer::add_schema(std::string_view name, std::string_view encodin
 std::uint16_t Writer::add_channel(std::uint16_t schema_id, std::string_view topic,
                                   std::string_view message_encoding,
                                   const std::vector<std::pair<std::string, std::string>>& metadata) {
-  if (schema_id == 0 || schema_id > schemas_.size())
-    throw std::invalid_argument("add_channel: unknown schema id");
+  if (schema_id == 0 || schema_id > schemas_.size()) throw std::logic_error("add_channel: unknown schema id");
   const auto id = static_cast<std::uint16_t>(channels_.size() + 1);
   channels_.push_back({id, schema_id, std::string(topic), std::string(message_encoding), metadata});
   StringMap map;
@@ -139,8 +138,7 @@ std::uint16_t Writer::add_channel(std::uint16_t schema_id, std::string_view topi
 void Writer::write(std::uint16_t channel_id, std::uint32_t sequence, std::uint64_t log_time,
                    std::uint64_t publish_time, std::span<const std::uint8_t> data) {
   if (!is_open()) throw WriteError("write after close");
-  if (channel_id == 0 || channel_id > channels_.size())
-    throw std::invalid_argument("write: unknown channel id");
+  if (channel_id == 0 || channel_id > channels_.size()) throw std::logic_error("write: unknown channel id");
   if (chunk_messages_ == 0) chunk_start_ = chunk_end_ = log_time;
   chunk_start_ = std::min(chunk_start_, log_time);
   chunk_end_ = std::max(chunk_end_, log_time);

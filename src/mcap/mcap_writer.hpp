@@ -26,13 +26,14 @@
 #include <vector>
 
 #include "mcap_records.hpp"
+#include "rsg/error.hpp"
 
 namespace rsg::mcap {
 
 /// A failed write or open; the message names the file and the system's reason.
-class WriteError : public std::runtime_error {
+class WriteError : public EnvironmentError {
  public:
-  using std::runtime_error::runtime_error;
+  using EnvironmentError::EnvironmentError;
 };
 
 struct WriterOptions {
@@ -62,7 +63,8 @@ struct WriterTotals {
 
 class Writer {
  public:
-  /// Creates (or truncates) `path` and writes the magic and the header. Throws WriteError.
+  /// Creates (or truncates) `path` and writes the magic and the header.
+  /// @throws WriteError.
   Writer(const std::filesystem::path& path, WriterOptions options);
   /// Finishes the file if close() was not called; errors are lost then, so call close() to see them.
   ~Writer();
@@ -78,7 +80,8 @@ class Writer {
                             const std::vector<std::pair<std::string, std::string>>& metadata);
 
   /// Adds one message to the open chunk; finishes the chunk when it is full. Messages must come in
-  /// log_time order. Throws WriteError (the file is then finished as far as possible and closed).
+  /// log_time order.
+  /// @throws WriteError (the file is then finished as far as possible and closed).
   void write(std::uint16_t channel_id, std::uint32_t sequence, std::uint64_t log_time,
              std::uint64_t publish_time, std::span<const std::uint8_t> data);
   /// Finishes the open chunk when its first message is older than chunk_span_ns at `now_ns`: call it
@@ -86,7 +89,8 @@ class Writer {
   void finish_chunk_if_older(std::uint64_t now_ns);
   /// Finishes the open chunk (if it has messages) and hands it to the kernel.
   void finish_chunk();
-  /// Writes the last chunk, the summary and the footer, and closes the file. Throws WriteError.
+  /// Writes the last chunk, the summary and the footer, and closes the file.
+  /// @throws WriteError.
   void close();
 
   const WriterTotals& totals() const { return totals_; }

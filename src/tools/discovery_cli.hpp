@@ -14,13 +14,14 @@
 namespace rsg::tools {
 
 inline void add_discovery_options(CLI::App& app, dds::DiscoveryOptions& options) {
-  const auto each = [](std::string (*check)(const std::string&)) {
-    return CLI::Validator([check](std::string& value) { return check(value); }, "", "");
+  // CLI11 takes "" for a good value: exactly what a failed Parsed says, and a good one.
+  const auto each = [](auto parse) {
+    return CLI::Validator([parse](std::string& value) { return parse(value).error(); }, "", "");
   };
   app.add_option("--discovery-server", options.servers, std::string(transport::kDiscoveryServerHelp))
-      ->check(each(transport::check_discovery_server));
+      ->check(each(transport::parse_discovery_server));
   app.add_option("--peer", options.peers, std::string(transport::kPeerHelp))
-      ->check(each(transport::check_peer));
+      ->check(each(transport::parse_peer));
 }
 
 }  // namespace rsg::tools

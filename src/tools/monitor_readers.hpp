@@ -16,6 +16,7 @@
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
+#include "rsg/error.hpp"
 
 namespace rsg::tools {
 
@@ -45,14 +46,14 @@ class MonitorReaders {
       state_ = view_reader_->get();
     } else {
       state_ = subscriber.create_datareader(&topic, qos);
-      if (state_ == nullptr) throw std::runtime_error("cannot create a reader on '" + topics.topic + "'");
+      if (state_ == nullptr) throw EnvironmentError("cannot create a reader on '" + topics.topic + "'");
     }
     if (!topics.status_topic.empty()) {
       fdds::Topic* status_topic =
           participant.topic(topics.status_topic, fdds::TypeSupport(new GatewayStatusPubSubType()));
       status_ = subscriber.create_datareader_with_profile(status_topic, "rsg_status_reader");
       if (status_ == nullptr)
-        throw std::runtime_error("cannot create a reader on '" + topics.status_topic + "'");
+        throw EnvironmentError("cannot create a reader on '" + topics.status_topic + "'");
     }
     for (fdds::DataReader* reader : {state_, status_}) {
       if (reader == nullptr || wake == WakeUp::kPeriodically) continue;

@@ -1,48 +1,47 @@
 #include "rsg/transport/host_port.hpp"
 
 #include <optional>
+#include <utility>
 
 #include "rsg/wire/number.hpp"
 
 namespace rsg::transport {
 
-std::string split_host_port(std::string_view value, HostPortRule rule, HostPort& out) {
+wire::Parsed<HostPort> parse_host_port(std::string_view value, HostPortRule rule) {
   const std::string quoted = "'" + std::string(value) + "'";
   const std::size_t colon = value.rfind(':');
   if (colon == std::string_view::npos) {
-    if (rule != HostPortRule::kPortOptional || value.empty()) return quoted + " is not HOST:PORT";
-    out = HostPort{std::string(value), 0};
-    return {};
+    if (rule != HostPortRule::kPortOptional || value.empty())
+      return wire::ParseFailure{quoted + " is not HOST:PORT"};
+    return HostPort{std::string(value), 0};
   }
-  if (colon == 0 && rule != HostPortRule::kBindAddress) return quoted + " is not HOST:PORT";
+  if (colon == 0 && rule != HostPortRule::kBindAddress)
+    return wire::ParseFailure{quoted + " is not HOST:PORT"};
   const bool zero_allowed = rule == HostPortRule::kPortMayBeZero || rule == HostPortRule::kBindAddress;
   const std::optional<unsigned> port = wire::parse_number<unsigned>(value.substr(colon + 1));
   if (!port || *port > 65535 || (*port == 0 && !zero_allowed))
-    return quoted + ": port must be a number " + (zero_allowed ? "0" : "1") + "..65535";
-  out = HostPort{std::string(value.substr(0, colon)), *port};
-  return {};
+    return wire::ParseFailure{quoted + ": port must be a number " + (zero_allowed ? "0" : "1") + "..65535"};
+  return HostPort{std::string(value.substr(0, colon)), *port};
 }
 
-std::string split_discovery_server(std::string_view value, unsigned& id, HostPort& out) {
+wire::Parsed<DiscoveryServer> parse_discovery_server(std::string_view value) {
+  DiscoveryServer server;
   std::string_view host_port = value;
   if (const std::size_t at = value.find('@'); at != std::string_view::npos) {
     const std::optional<unsigned> given = wire::parse_number<unsigned>(value.substr(0, at));
-    if (!given || *given > 255) return "'" + std::string(value) + "': server id before '@' must be 0..255";
-    id = *given;
+    if (!given || *given > 255)
+      return wire::ParseFailure{"'" + std::string(value) + "': server id before '@' must be 0..255"};
+    server.id = *given;
     host_port = value.substr(at + 1);
   }
-  return split_host_port(host_port, HostPortRule::kPortRequired, out);
+  wire::Parsed<HostPort> address = parse_host_port(host_port, HostPortRule::kPortRequired);
+  if (!address) return wire::ParseFailure{address.error()};
+  server.address = std::move(address).value();
+  return server;
 }
 
-std::string check_discovery_server(const std::string& value) {
-  unsigned id = 0;
-  HostPort parsed;
-  return split_discovery_server(value, id, parsed);
-}
-
-std::string check_peer(const std::string& value) {
-  HostPort parsed;
-  return split_host_port(value, HostPortRule::kPortOptional, parsed);
+wire::Parsed<HostPort> parse_peer(std::string_view value) {
+  return parse_host_port(value, HostPortRule::kPortOptional);
 }
 
 }  // namespace rsg::transport

@@ -8,20 +8,19 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <stdexcept>
-#include <system_error>
+#include <string>
 
+#include "rsg/error.hpp"
 #include "rsg/transport/host_port.hpp"
 
 namespace rsg::transport {
 
 Endpoint Endpoint::parse(std::string_view host_port) {
   const std::string text(host_port);
-  HostPort parts;
-  if (std::string error = split_host_port(text, HostPortRule::kBindAddress, parts); !error.empty())
-    throw std::invalid_argument(error);
-  std::string host = std::move(parts.host);
-  const std::string port = std::to_string(parts.port);
+  wire::Parsed<HostPort> parts = parse_host_port(text, HostPortRule::kBindAddress);
+  if (!parts) throw InputError(parts.error());
+  std::string host = parts->host;
+  const std::string port = std::to_string(parts->port);
   if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
   if (host.empty() || host == "*") host = "0.0.0.0";
 
@@ -31,7 +30,7 @@ Endpoint Endpoint::parse(std::string_view host_port) {
   hints.ai_flags = AI_NUMERICSERV;
   addrinfo* found = nullptr;
   if (const int status = ::getaddrinfo(host.c_str(), port.c_str(), &hints, &found); status != 0)
-    throw std::invalid_argument("'" + text + "': " + ::gai_strerror(status));
+    throw InputError("'" + text + "': " + ::gai_strerror(status));
   Endpoint endpoint;
   std::memcpy(&endpoint.storage_, found->ai_addr, found->ai_addrlen);
   endpoint.size_ = static_cast<socklen_t>(found->ai_addrlen);
@@ -92,18 +91,18 @@ DatagramBatch::Datagram DatagramBatch::operator[](std::size_t index) const {
 
 UdpSocket UdpSocket::bind(const Endpoint& local) {
   const int fd = ::socket(local.family(), SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) throw std::system_error(errno, std::generic_category(), "socket()");
+  if (fd < 0) throw EnvironmentError(std::string("cannot open a UDP socket: ") + std::strerror(errno));
   // No SO_REUSEADDR: on UDP it would let a second process bind the same port and silently take
   // part of the stream. UDP has no TIME_WAIT, so a restarted gateway rebinds without it.
   UdpSocket socket(fd);
   if (::bind(fd, local.address(), local.size()) != 0)
-    throw std::system_error(errno, std::generic_category(), "cannot bind UDP " + local.to_string());
+    throw EnvironmentError("cannot bind UDP " + local.to_string() + ": " + std::strerror(errno));
   return socket;
 }
 
 UdpSocket UdpSocket::for_sending_to(const Endpoint& peer) {
   const int fd = ::socket(peer.family(), SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) throw std::system_error(errno, std::generic_category(), "socket()");
+  if (fd < 0) throw EnvironmentError(std::string("cannot open a UDP socket: ") + std::strerror(errno));
   return UdpSocket(fd);
 }
 

@@ -211,7 +211,9 @@ std::string to_canonical_json(const StateValues& values) {
   return out;
 }
 
-bool parse_canonical_json(std::string_view text, StateValues& out, std::string& error) {
+namespace {
+
+bool parse_into(std::string_view text, StateValues& out, std::string& error) {
   Json root;
   try {
     root = Json::parse(text);
@@ -256,6 +258,15 @@ bool parse_canonical_json(std::string_view text, StateValues& out, std::string& 
   }
   out = values;
   return true;
+}
+
+}  // namespace
+
+Parsed<StateValues> parse_canonical_json(std::string_view text) {
+  StateValues values;
+  std::string error;
+  if (!parse_into(text, values, error)) return ParseFailure{std::move(error)};
+  return values;
 }
 
 }  // namespace rsg::wire

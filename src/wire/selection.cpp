@@ -1,6 +1,7 @@
 #include "rsg/wire/selection.hpp"
 
-#include <charconv>
+#include <string>
+#include <utility>
 
 #include "group_bytes.hpp"
 #include "rsg/wire/number.hpp"
@@ -8,31 +9,20 @@
 namespace rsg::wire {
 namespace {
 
+// Calls on_item (which returns "" or what is wrong with the item) for each trimmed item of a
+// comma-separated list; returns the first complaint, or "".
 template <class OnItem>
-bool for_each_item(std::string_view list, std::string& error, OnItem&& on_item) {
-  if (list.empty()) {
-    error = "empty list";
-    return false;
-  }
+std::string for_each_item(std::string_view list, OnItem&& on_item) {
+  if (list.empty()) return "empty list";
   while (true) {
     const std::size_t comma = list.find(',');
     std::string_view item = list.substr(0, comma);
     while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
     while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
-    if (!on_item(item)) return false;
-    if (comma == std::string_view::npos) return true;
+    if (std::string why = on_item(item); !why.empty()) return why;
+    if (comma == std::string_view::npos) return {};
     list.remove_prefix(comma + 1);
   }
-}
-
-bool parse_group(std::string_view item, std::size_t& group, std::string& error) {
-  const std::optional<unsigned> value = parse_number<unsigned>(item);
-  if (!value || *value >= kGroupCount) {
-    error = "'" + std::string(item) + "' is not a group number 0..5";
-    return false;
-  }
-  group = *value;
-  return true;
 }
 
 }  // namespace
@@ -44,38 +34,34 @@ std::uint16_t Selection::data_bytes() const {
   return total;
 }
 
-bool parse_field_list(std::string_view list, Selection& out, std::string& error) {
+Parsed<Selection> parse_field_list(std::string_view list) {
   Selection selection;
-  const bool ok = for_each_item(list, error, [&](std::string_view item) {
+  std::string why = for_each_item(list, [&](std::string_view item) -> std::string {
     const auto field = find_field(item);
-    if (!field) {
-      error = "'" + std::string(item) + "' is not a field name of docs/protocol.md";
-      return false;
-    }
+    if (!field) return "'" + std::string(item) + "' is not a field name of docs/protocol.md";
     selection.add(*field);
-    return true;
+    return {};
   });
-  if (ok) out = selection;
-  return ok;
+  if (!why.empty()) return ParseFailure{std::move(why)};
+  return selection;
 }
 
-bool parse_group_list(std::string_view list, Selection& out, std::string& error) {
+Parsed<Selection> parse_group_list(std::string_view list) {
   Selection selection;
-  const bool ok = for_each_item(list, error, [&](std::string_view item) {
-    std::size_t group = 0;
-    if (!parse_group(item, group, error)) return false;
-    selection.add_group(group);
-    return true;
+  std::string why = for_each_item(list, [&](std::string_view item) -> std::string {
+    const std::optional<unsigned> group = parse_number<unsigned>(item);
+    if (!group || *group >= kGroupCount) return "'" + std::string(item) + "' is not a group number 0..5";
+    selection.add_group(*group);
+    return {};
   });
-  if (ok) out = selection;
-  return ok;
+  if (!why.empty()) return ParseFailure{std::move(why)};
+  return selection;
 }
 
-bool parse_group_mask(std::string_view list, std::uint8_t& out, std::string& error) {
-  Selection selection;
-  if (!parse_group_list(list, selection, error)) return false;
-  out = selection.group_select;
-  return true;
+Parsed<std::uint8_t> parse_group_mask(std::string_view list) {
+  Parsed<Selection> selection = parse_group_list(list);
+  if (!selection) return ParseFailure{selection.error()};
+  return selection->group_select;
 }
 
 }  // namespace rsg::wire

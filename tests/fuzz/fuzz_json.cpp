@@ -12,12 +12,12 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  rsg::wire::StateValues parsed;
-  std::string error;
-  if (!rsg::wire::parse_canonical_json(text, parsed, error)) {
-    FUZZ_REQUIRE(!error.empty());
+  const rsg::wire::Parsed<rsg::wire::StateValues> result = rsg::wire::parse_canonical_json(text);
+  if (!result) {
+    FUZZ_REQUIRE(!result.error().empty());
     return 0;
   }
+  const rsg::wire::StateValues& parsed = *result;
 
   std::array<std::uint8_t, rsg::wire::kMaxFrameBytes> frame{};
   const rsg::wire::EncodeResult encoded = rsg::wire::encode(
@@ -31,9 +31,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FUZZ_REQUIRE(values == parsed);  // NaN from JSON is the canonical quiet NaN, so bits match too
 
   const std::string canonical = rsg::wire::to_canonical_json(values);
-  rsg::wire::StateValues reparsed;
-  FUZZ_REQUIRE(rsg::wire::parse_canonical_json(canonical, reparsed, error));
-  FUZZ_REQUIRE(reparsed == values);
-  FUZZ_REQUIRE(rsg::wire::to_canonical_json(reparsed) == canonical);
+  const rsg::wire::Parsed<rsg::wire::StateValues> reparsed = rsg::wire::parse_canonical_json(canonical);
+  FUZZ_REQUIRE(reparsed);
+  FUZZ_REQUIRE(*reparsed == values);
+  FUZZ_REQUIRE(rsg::wire::to_canonical_json(*reparsed) == canonical);
   return 0;
 }

@@ -14,6 +14,7 @@
 
 #include "fuzz_check.hpp"
 #include "pcap_file.hpp"
+#include "rsg/error.hpp"
 #include "udp_packet.hpp"
 
 namespace {
@@ -51,7 +52,7 @@ void read_file(std::span<const std::uint8_t> file) {
       if (!packet) break;
       check_round_trip(*packet);
     }
-  } catch (const std::runtime_error&) {
+  } catch (const rsg::Error&) {
     // A file libpcap rejects, or an unsupported link type: a clear error, which is the point.
   }
 }

@@ -136,7 +136,7 @@ TEST_F(EmbeddedGatewayTest, UnusableConfigurationThrowsNamingTheProblem) {
   const auto message_of = [](const std::string& yaml) {
     try {
       gateway::EmbeddedGateway gateway(yaml, [](const RobotState&) {});
-    } catch (const std::invalid_argument& error) {
+    } catch (const rsg::InputError& error) {
       return std::string(error.what());
     }
     return std::string("no exception");

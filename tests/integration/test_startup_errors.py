@@ -1,5 +1,7 @@
 """Bad flags, files and profiles: one message naming the problem, exit status 2, and nothing
-started (the listening port is still free). Also: --allow-from rejects other senders."""
+started (the listening port is still free). A port another process holds is the machine's refusal,
+not a usage error: exit status 1, for the gateway and a tool alike (src/tools/tool_main.hpp).
+Also: --allow-from rejects other senders."""
 
 import json
 import os
@@ -52,6 +54,26 @@ def body(h):
                                "--writer-profile", "rsg_state_writer")
     wait_for_stats(stats, lambda s: True, "the gateway to start with the flag's profile")
     check(h.stop("overridden", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+
+    # The port is taken: the environment refuses (exit 1), the message names the address.
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as holder:
+        holder.bind(("127.0.0.1", 0))
+        taken = holder.getsockname()[1]
+        status = h.run("port_taken", [h.binary("rsg_gateway"), "--domain", str(h.domain),
+                                      "--listen", f"127.0.0.1:{taken}"])
+        message = (h.dir / "port_taken.err").read_text()
+        check(status == 1, f"port_taken: exit status {status}, expected 1 ({message.strip()})")
+        check(f"127.0.0.1:{taken}" in message and message.startswith("rsg_gateway: "),
+              f"port_taken: message does not name the address: {message.strip()}")
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as holder:
+        holder.bind(("127.0.0.1", 0))
+        holder.listen()
+        taken = holder.getsockname()[1]
+        status = h.run("view_port_taken", [h.binary("rsg_view"), "--domain", str(h.domain),
+                                           "--listen", f"127.0.0.1:{taken}"])
+        message = (h.dir / "view_port_taken.err").read_text()
+        check(status == 1, f"view_port_taken: exit status {status}, expected 1 ({message.strip()})")
+        check(str(taken) in message, f"view_port_taken: message does not name the port: {message.strip()}")
 
     # --allow-from: frames from 127.0.0.1 are not in 10.0.0.0/8.
     port = free_udp_port()

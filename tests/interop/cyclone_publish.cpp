@@ -53,15 +53,15 @@ int main(int argc, char** argv) {
       return 1;
     }
 
-    rsg::wire::StateValues values;
     rsg_RobotState sample;
-    std::string line, error;
+    std::string line;
     while (std::getline(input, line)) {
-      if (!rsg::wire::parse_canonical_json(line, values, error)) {
-        std::cerr << "rsg_cyclone_publish: " << error << '\n';
+      const rsg::wire::Parsed<rsg::wire::StateValues> values = rsg::wire::parse_canonical_json(line);
+      if (!values) {
+        std::cerr << "rsg_cyclone_publish: " << values.error() << '\n';
         return 2;
       }
-      rsg::interop::to_sample(values, sample);
+      rsg::interop::to_sample(*values, sample);
       if (const dds_return_t rc = dds_write(writer.get(), &sample); rc != DDS_RETCODE_OK) {
         std::cerr << "rsg_cyclone_publish: dds_write: " << dds_strretcode(rc) << '\n';
         return 1;

@@ -66,15 +66,15 @@ int publish(dds_domainid_t domain, const std::string& topic_name, const char* fi
     std::cerr << "rsg_ros2_cyclone_echo: no reader on " << topic_name << '\n';
     return 1;
   }
-  rsg::wire::StateValues values;
   rsg_msgs_msg_dds__RobotState_ sample;
-  std::string line, error;
+  std::string line;
   while (std::getline(input, line)) {
-    if (!rsg::wire::parse_canonical_json(line, values, error)) {
-      std::cerr << "rsg_ros2_cyclone_echo: " << error << '\n';
+    const rsg::wire::Parsed<rsg::wire::StateValues> values = rsg::wire::parse_canonical_json(line);
+    if (!values) {
+      std::cerr << "rsg_ros2_cyclone_echo: " << values.error() << '\n';
       return 2;
     }
-    rsg::interop::to_sample(values, layout, sample);
+    rsg::interop::to_sample(*values, layout, sample);
     if (const dds_return_t rc = dds_write(writer.get(), &sample); rc != DDS_RETCODE_OK) {
       std::cerr << "rsg_ros2_cyclone_echo: dds_write: " << dds_strretcode(rc) << '\n';
       return 1;

@@ -9,48 +9,55 @@ namespace rsg {
 namespace {
 
 TEST(HostPort, EachRuleAcceptsWhatItNames) {
-  transport::HostPort out;
-  EXPECT_EQ(transport::split_host_port("robot:17000", transport::HostPortRule::kPortRequired, out), "");
-  EXPECT_EQ(out.host, "robot");
-  EXPECT_EQ(out.port, 17000u);
-  EXPECT_EQ(transport::split_host_port("[::1]:5", transport::HostPortRule::kPortRequired, out), "");
-  EXPECT_EQ(out.host, "[::1]");
-  EXPECT_EQ(transport::split_host_port("0.0.0.0:0", transport::HostPortRule::kPortMayBeZero, out), "");
-  EXPECT_EQ(transport::split_host_port("peer", transport::HostPortRule::kPortOptional, out), "");
-  EXPECT_EQ(out.host, "peer");
-  EXPECT_EQ(out.port, 0u);
-  EXPECT_EQ(transport::split_host_port(":0", transport::HostPortRule::kBindAddress, out), "");
-  EXPECT_EQ(out.host, "");
+  using transport::HostPortRule;
+  const auto parsed = [](std::string_view value, HostPortRule rule) {
+    const wire::Parsed<transport::HostPort> result = transport::parse_host_port(value, rule);
+    EXPECT_TRUE(result) << value << ": " << result.error();
+    return result ? *result : transport::HostPort{};
+  };
+  EXPECT_EQ(parsed("robot:17000", HostPortRule::kPortRequired).host, "robot");
+  EXPECT_EQ(parsed("robot:17000", HostPortRule::kPortRequired).port, 17000u);
+  EXPECT_EQ(parsed("[::1]:5", HostPortRule::kPortRequired).host, "[::1]");
+  EXPECT_EQ(parsed("0.0.0.0:0", HostPortRule::kPortMayBeZero).port, 0u);
+  EXPECT_EQ(parsed("peer", HostPortRule::kPortOptional).host, "peer");
+  EXPECT_EQ(parsed("peer", HostPortRule::kPortOptional).port, 0u);
+  EXPECT_EQ(parsed(":0", HostPortRule::kBindAddress).host, "");
+  EXPECT_EQ(transport::parse_peer("h:7400")->port, 7400u);
 }
 
 TEST(HostPort, BadValuesSayWhatIsWrong) {
-  transport::HostPort out;
-  EXPECT_EQ(transport::split_host_port("robot", transport::HostPortRule::kPortRequired, out),
-            "'robot' is not HOST:PORT");
-  EXPECT_EQ(transport::split_host_port(":1", transport::HostPortRule::kPortRequired, out),
-            "':1' is not HOST:PORT");
-  EXPECT_EQ(transport::split_host_port("", transport::HostPortRule::kPortOptional, out),
-            "'' is not HOST:PORT");
-  EXPECT_EQ(transport::split_host_port("h:0", transport::HostPortRule::kPortRequired, out),
-            "'h:0': port must be a number 1..65535");
-  EXPECT_EQ(transport::split_host_port("h:65536", transport::HostPortRule::kPortMayBeZero, out),
-            "'h:65536': port must be a number 0..65535");
-  EXPECT_EQ(transport::split_host_port("h: 1", transport::HostPortRule::kPortRequired, out),
-            "'h: 1': port must be a number 1..65535");
-  unsigned id = 7;
-  EXPECT_EQ(transport::split_discovery_server("x@h:1", id, out),
+  using transport::HostPortRule;
+  const auto error = [](std::string_view value, HostPortRule rule) {
+    const wire::Parsed<transport::HostPort> result = transport::parse_host_port(value, rule);
+    EXPECT_FALSE(result) << value;
+    return result.error();
+  };
+  EXPECT_EQ(error("robot", HostPortRule::kPortRequired), "'robot' is not HOST:PORT");
+  EXPECT_EQ(error(":1", HostPortRule::kPortRequired), "':1' is not HOST:PORT");
+  EXPECT_EQ(error("", HostPortRule::kPortOptional), "'' is not HOST:PORT");
+  EXPECT_EQ(error("h:0", HostPortRule::kPortRequired), "'h:0': port must be a number 1..65535");
+  EXPECT_EQ(error("h:65536", HostPortRule::kPortMayBeZero), "'h:65536': port must be a number 0..65535");
+  EXPECT_EQ(error("h: 1", HostPortRule::kPortRequired), "'h: 1': port must be a number 1..65535");
+  EXPECT_EQ(transport::parse_discovery_server("x@h:1").error(),
             "'x@h:1': server id before '@' must be 0..255");
-  EXPECT_EQ(id, 7u);
-  EXPECT_EQ(transport::split_discovery_server("3@h:1", id, out), "");
-  EXPECT_EQ(id, 3u);
+}
+
+TEST(HostPort, ADiscoveryServerIdIsOptional) {
+  const wire::Parsed<transport::DiscoveryServer> with_id = transport::parse_discovery_server("3@h:1");
+  ASSERT_TRUE(with_id) << with_id.error();
+  EXPECT_EQ(with_id->id, 3u);
+  EXPECT_EQ(with_id->address.host, "h");
+  const wire::Parsed<transport::DiscoveryServer> without = transport::parse_discovery_server("h:1");
+  ASSERT_TRUE(without) << without.error();
+  EXPECT_FALSE(without->id.has_value());
 }
 
 TEST(HostPort, EndpointParseUsesTheSameSyntax) {
   EXPECT_EQ(transport::Endpoint::parse(":0").to_string(), "0.0.0.0:0");
   EXPECT_EQ(transport::Endpoint::parse("*:17000").to_string(), "0.0.0.0:17000");
   EXPECT_EQ(transport::Endpoint::parse("[::1]:9").to_string(), "[::1]:9");
-  EXPECT_THROW(transport::Endpoint::parse("127.0.0.1"), std::invalid_argument);
-  EXPECT_THROW(transport::Endpoint::parse("127.0.0.1:x"), std::invalid_argument);
+  EXPECT_THROW(transport::Endpoint::parse("127.0.0.1"), rsg::InputError);
+  EXPECT_THROW(transport::Endpoint::parse("127.0.0.1:x"), rsg::InputError);
 }
 
 }  // namespace

@@ -11,9 +11,9 @@ namespace {
 TEST(Json, SpecExampleRoundTrips) {
   const std::string text =
       R"({"packet_number":5,"group_select":4,"data_select":[0,0,32,0,0,0],"fields":{"q":[0.1,0.2,0.3,0.4,0.5,0.6,0.7]}})";
-  wire::StateValues values;
-  std::string error;
-  ASSERT_TRUE(wire::parse_canonical_json(text, values, error)) << error;
+  const wire::Parsed<wire::StateValues> values_parsed = wire::parse_canonical_json(text);
+  ASSERT_TRUE(values_parsed) << values_parsed.error();
+  const wire::StateValues& values = *values_parsed;
   EXPECT_EQ(values.doubles(wire::Field::q)[6], 0.7);
   EXPECT_EQ(wire::to_canonical_json(values), text);
 }
@@ -43,9 +43,9 @@ TEST(Json, SpecialValuesAndScalars) {
       std::string::npos);
   EXPECT_NE(json.find(R"("time":18446744073709551615)"), std::string::npos);
 
-  wire::StateValues parsed;
-  std::string error;
-  ASSERT_TRUE(wire::parse_canonical_json(json, parsed, error)) << error;
+  const wire::Parsed<wire::StateValues> parsed_parsed = wire::parse_canonical_json(json);
+  ASSERT_TRUE(parsed_parsed) << parsed_parsed.error();
+  const wire::StateValues& parsed = *parsed_parsed;
   EXPECT_TRUE(std::signbit(parsed.doubles(wire::Field::m_ee)[0]));
   EXPECT_TRUE(std::isnan(parsed.doubles(wire::Field::q)[0]));
   EXPECT_EQ(parsed.integer(wire::Field::time), 18446744073709551615ULL);
@@ -59,10 +59,9 @@ struct BadInput {
 class JsonErrors : public testing::TestWithParam<BadInput> {};
 
 TEST_P(JsonErrors, AreReadable) {
-  wire::StateValues values;
-  std::string error;
-  EXPECT_FALSE(wire::parse_canonical_json(GetParam().json, values, error));
-  EXPECT_NE(error.find(GetParam().expected_error), std::string::npos) << error;
+  const wire::Parsed<wire::StateValues> values = wire::parse_canonical_json(GetParam().json);
+  EXPECT_FALSE(values);
+  EXPECT_NE(values.error().find(GetParam().expected_error), std::string::npos) << values.error();
 }
 
 INSTANTIATE_TEST_SUITE_P(

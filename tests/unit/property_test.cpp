@@ -31,10 +31,10 @@ TEST(Property, CanonicalJsonRoundTripsExactly) {
   std::mt19937_64 rng(7);
   for (int round = 0; round < kRounds; ++round) {
     const wire::StateValues original = test::random_state(rng, /*allow_nan_payloads=*/false);
-    wire::StateValues parsed;
-    std::string error;
     const std::string json = wire::to_canonical_json(original);
-    ASSERT_TRUE(wire::parse_canonical_json(json, parsed, error)) << error << "\n" << json;
+    const wire::Parsed<wire::StateValues> result = wire::parse_canonical_json(json);
+    ASSERT_TRUE(result) << result.error() << "\n" << json;
+    const wire::StateValues& parsed = *result;
     ASSERT_EQ(parsed, original) << json;
   }
 }

@@ -15,26 +15,31 @@ TEST(Selection, AllFieldsImplyTheFullDataSection) {
 }
 
 TEST(Selection, ParsesFieldAndGroupLists) {
-  wire::Selection selection;
-  std::string error;
-  ASSERT_TRUE(wire::parse_field_list("q, dq,time", selection, error)) << error;
-  EXPECT_TRUE(selection.contains(wire::Field::q));
-  EXPECT_TRUE(selection.contains(wire::Field::time));
-  EXPECT_EQ(selection.group_select, 0b100100);
-  EXPECT_EQ(selection.data_bytes(), 56 + 56 + 8);
+  const wire::Parsed<wire::Selection> fields = wire::parse_field_list("q, dq,time");
+  ASSERT_TRUE(fields) << fields.error();
+  EXPECT_TRUE(fields->contains(wire::Field::q));
+  EXPECT_TRUE(fields->contains(wire::Field::time));
+  EXPECT_EQ(fields->group_select, 0b100100);
+  EXPECT_EQ(fields->data_bytes(), 56 + 56 + 8);
 
-  ASSERT_TRUE(wire::parse_group_list("2", selection, error));
-  EXPECT_EQ(selection.data_bytes(), 368);
-  EXPECT_FALSE(wire::parse_group_list("6", selection, error));
-  EXPECT_NE(error.find("'6' is not a group number"), std::string::npos);
-  EXPECT_FALSE(wire::parse_field_list("q,nope", selection, error));
-  EXPECT_NE(error.find("'nope'"), std::string::npos);
+  const wire::Parsed<wire::Selection> group = wire::parse_group_list("2");
+  ASSERT_TRUE(group) << group.error();
+  EXPECT_EQ(group->data_bytes(), 368);
+  EXPECT_EQ(group.error(), "");
+  const wire::Parsed<wire::Selection> no_group = wire::parse_group_list("6");
+  EXPECT_FALSE(no_group);
+  EXPECT_NE(no_group.error().find("'6' is not a group number"), std::string::npos);
+  const wire::Parsed<wire::Selection> no_field = wire::parse_field_list("q,nope");
+  EXPECT_FALSE(no_field);
+  EXPECT_NE(no_field.error().find("'nope'"), std::string::npos);
+  EXPECT_EQ(wire::parse_group_list("").error(), "empty list");
+  const wire::Parsed<std::uint8_t> mask = wire::parse_group_mask("0, 2");
+  ASSERT_TRUE(mask) << mask.error();
+  EXPECT_EQ(*mask, 0b101);
 }
 
 TEST(SelectionRequest, RoundTripsAndIsRejectedByTheStateDecoder) {
-  wire::Selection wanted;
-  std::string error;
-  ASSERT_TRUE(wire::parse_group_list("2", wanted, error));
+  const wire::Selection wanted = *wire::parse_group_list("2");
   std::array<std::uint8_t, wire::kSelectionRequestBytes> frame{};
   const wire::EncodeResult encoded = encode_selection_request(3, wanted, frame);
   ASSERT_TRUE(encoded) << encoded.error.message();

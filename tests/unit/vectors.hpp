@@ -25,8 +25,9 @@ inline std::vector<Vector> load_vectors(const std::string& file, const char* key
     if (line.empty()) continue;
     const auto json = nlohmann::json::parse(line);
     Vector vector;
-    if (!wire::from_hex(json.at("frame_hex").get<std::string>(), vector.frame))
-      throw std::runtime_error("bad hex");
+    wire::Parsed<std::vector<std::uint8_t>> frame = wire::from_hex(json.at("frame_hex").get<std::string>());
+    if (!frame) throw std::runtime_error("frame_hex: " + frame.error());
+    vector.frame = std::move(frame).value();
     vector.expected = json.at(key);
     vector.decoded_text = vector.expected.dump();
     vectors.push_back(std::move(vector));

@@ -27,9 +27,9 @@ TEST(Vectors, ValidFramesDecodeToTheExpectedValues) {
     wire::StateValues decoded;
     decoded.assign(result.frame());
 
-    wire::StateValues expected;
-    std::string error;
-    ASSERT_TRUE(wire::parse_canonical_json(vector.decoded_text, expected, error)) << error;
+    const wire::Parsed<wire::StateValues> expected_parsed = wire::parse_canonical_json(vector.decoded_text);
+    ASSERT_TRUE(expected_parsed) << expected_parsed.error();
+    const wire::StateValues& expected = *expected_parsed;
     EXPECT_EQ(decoded, expected);  // bit-exact, so -0.0 keeps its sign
 
     // Our JSON says the same, compared by value as the spec asks.
@@ -40,9 +40,9 @@ TEST(Vectors, ValidFramesDecodeToTheExpectedValues) {
 TEST(Vectors, ValidFramesEncodeByteForByte) {
   for (const auto& vector : test::valid_vectors()) {
     SCOPED_TRACE(vector.decoded_text.substr(0, 120));
-    wire::StateValues values;
-    std::string error;
-    ASSERT_TRUE(wire::parse_canonical_json(vector.decoded_text, values, error)) << error;
+    const wire::Parsed<wire::StateValues> values_parsed = wire::parse_canonical_json(vector.decoded_text);
+    ASSERT_TRUE(values_parsed) << values_parsed.error();
+    const wire::StateValues& values = *values_parsed;
     std::array<std::uint8_t, wire::kMaxFrameBytes> out{};
     const wire::EncodeResult result =
         encode(values.packet_number, values.selection, values.storage(), wire::StateValues::layout(), out);
@@ -75,9 +75,9 @@ TEST(Vectors, ValidFramesDecodeThroughFrameCodec) {
     ASSERT_TRUE(result) << result.error().message();
     decoded.packet_number = result.frame().packet_number();
     decoded.selection = result.frame().selection();
-    wire::StateValues expected;
-    std::string error;
-    ASSERT_TRUE(wire::parse_canonical_json(vector.decoded_text, expected, error)) << error;
+    const wire::Parsed<wire::StateValues> expected_parsed = wire::parse_canonical_json(vector.decoded_text);
+    ASSERT_TRUE(expected_parsed) << expected_parsed.error();
+    const wire::StateValues& expected = *expected_parsed;
     EXPECT_EQ(decoded, expected);
   }
 }

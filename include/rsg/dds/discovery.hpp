@@ -17,7 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "rsg/transport/host_port.hpp"  // check_discovery_server, check_peer, kGatewayParticipantIds
+#include "rsg/error.hpp"
+#include "rsg/transport/host_port.hpp"  // parse_discovery_server, parse_peer, kGatewayParticipantIds
 
 namespace rsg::dds {
 
@@ -37,8 +38,8 @@ struct DiscoveryOptions {
 /// Makes `qos` use the given servers or peers on `domain` (nothing changes when `options` is
 /// empty). With either, the participant announces itself at Fast DDS's default period (3 s), not
 /// rsg_participant's 0.5 s: each announcement then goes to every server or peer port. Resolves
-/// host names (IPv4: rsg's participants use the UDPv4 transport). Throws std::invalid_argument
-/// naming the bad value.
+/// host names (IPv4: rsg's participants use the UDPv4 transport).
+/// @throws rsg::InputError naming a malformed or unresolvable server or peer.
 void apply_discovery(const DiscoveryOptions& options, int domain,
                      eprosima::fastdds::dds::DomainParticipantQos& qos);
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "rsg/dds/discovery.hpp"
+#include "rsg/error.hpp"
 
 namespace rsg::dds {
 
@@ -25,12 +26,15 @@ class Participant {
  public:
   /// Creates the participant from an XML participant profile (load_profiles first), on `domain`;
   /// an empty profile name means Fast DDS's default participant QoS.
-  /// Throws std::runtime_error when Fast DDS refuses.
+  /// @throws rsg::InputError when no such profile is loaded.
+  /// @throws rsg::EnvironmentError when Fast DDS refuses the participant.
   Participant(int domain, const std::string& profile);
   /// Same, then finds the others through `discovery`'s servers or peers instead of multicast.
-  /// Throws std::invalid_argument for a bad server or peer.
+  /// @throws rsg::InputError for an unknown profile or a bad server or peer.
+  /// @throws rsg::EnvironmentError when Fast DDS refuses the participant.
   Participant(int domain, const std::string& profile, const DiscoveryOptions& discovery);
   /// Creates the participant from explicit QoS.
+  /// @throws rsg::EnvironmentError when Fast DDS refuses the participant.
   Participant(int domain, const eprosima::fastdds::dds::DomainParticipantQos& qos);
   ~Participant();
   Participant(const Participant&) = delete;

@@ -25,8 +25,9 @@
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/topic/ContentFilteredTopic.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
-#include <stdexcept>
 #include <string>
+
+#include "rsg/error.hpp"
 
 namespace rsg::dds {
 
@@ -41,9 +42,9 @@ inline constexpr const char* kLoggerReaderProfile = "reader_logger";
 
 /// A view profile that cannot be used: unknown, not a view, or malformed. The message names the
 /// profile and says what is wrong with it.
-class ViewError : public std::runtime_error {
+class ViewError : public InputError {
  public:
-  using std::runtime_error::runtime_error;
+  using InputError::InputError;
 };
 
 /// What a reader on a view receives.
@@ -56,20 +57,22 @@ struct View {
 };
 
 /// The DDS-SQL filter "group_present[g] = TRUE AND ..." for every bit g of `groups`, ascending.
-/// Throws ViewError for 0 (a filter that accepts everything is no view) or reserved bits 6, 7.
+/// @throws ViewError for 0 (a filter that accepts everything is no view) or reserved bits 6, 7.
 std::string group_filter_expression(std::uint8_t groups);
 
 /// The view on `groups`, named "groups_0_2", for readers configured without a profile.
 View group_view(std::uint8_t groups);
 
 /// The view a reader profile's properties describe (`profile` only names it in errors).
-/// Throws ViewError when it has neither or both of the view properties, or a bad group list.
+/// @throws ViewError when it has neither or both of the view properties, or a bad group list.
 View parse_view(const std::string& profile, const eprosima::fastdds::dds::DataReaderQos& qos);
 
-/// Reads the view from an XML data_reader profile (load_profiles first). Throws ViewError.
+/// Reads the view from an XML data_reader profile (load_profiles first).
+/// @throws ViewError for an unknown or unusable profile.
 View load_view(const eprosima::fastdds::dds::Subscriber& subscriber, const std::string& profile);
 
-/// Reads an XML data_reader profile's QoS. Throws ViewError naming an unknown profile.
+/// Reads an XML data_reader profile's QoS.
+/// @throws ViewError naming an unknown profile.
 eprosima::fastdds::dds::DataReaderQos load_reader_qos(const eprosima::fastdds::dds::Subscriber& subscriber,
                                                       const std::string& profile);
 
@@ -81,8 +84,10 @@ eprosima::fastdds::dds::DataReaderQos load_reader_qos(const eprosima::fastdds::d
 class ViewReader {
  public:
   /// A reader on the view `view_profile` with the QoS of `qos_profile`; an empty `qos_profile`
-  /// keeps the view profile's own QoS. Throws ViewError for unusable profiles and
-  /// std::runtime_error when Fast DDS refuses an entity.
+  /// keeps the view profile's own QoS.
+  /// @throws ViewError for unusable profiles or a filter Fast DDS cannot parse.
+  /// @throws rsg::EnvironmentError when Fast DDS refuses the reader.
+  /// @throws std::logic_error when `subscriber` and `topic` belong to different participants.
   ViewReader(eprosima::fastdds::dds::Subscriber& subscriber, eprosima::fastdds::dds::Topic& topic,
              const std::string& view_profile, const std::string& qos_profile,
              eprosima::fastdds::dds::DataReaderListener* listener = nullptr,

@@ -27,6 +27,7 @@
 #include <string_view>
 
 #include "rsg/dds/robot_state.hpp"
+#include "rsg/error.hpp"
 #include "rsg/transport/udp_socket.hpp"
 
 namespace rsg::gateway {
@@ -36,9 +37,9 @@ class EmbeddedGateway {
   using SampleCallback = std::function<void(const RobotState& sample)>;
 
   /// Checks `yaml_config`, binds the UDP socket, creates the DDS entities and starts the ingress
-  /// thread, which calls `on_sample` from then on. Throws std::invalid_argument when the
-  /// configuration is unusable (the message names the key or line), std::runtime_error /
-  /// std::system_error when the socket or a DDS entity cannot be created; nothing is left running.
+  /// thread, which calls `on_sample` from then on. Nothing is left running when it throws.
+  /// @throws rsg::InputError when the configuration is unusable (the message names the key or line).
+  /// @throws rsg::EnvironmentError when the socket or a DDS entity cannot be created.
   EmbeddedGateway(std::string_view yaml_config, SampleCallback on_sample);
   /// Stops (see stop()).
   ~EmbeddedGateway();
@@ -47,8 +48,8 @@ class EmbeddedGateway {
   EmbeddedGateway(const EmbeddedGateway&) = delete;
   EmbeddedGateway& operator=(const EmbeddedGateway&) = delete;
 
-  /// Where frames are received (with `listen: HOST:0`, the port the kernel picked). Throws
-  /// std::logic_error after stop().
+  /// Where frames are received (with `listen: HOST:0`, the port the kernel picked).
+  /// @throws std::logic_error after stop(): a bug in the caller.
   transport::Endpoint local_endpoint() const;
 
   /// Ends the ingress thread (within 100 ms), publishes the final status, deletes the DDS

@@ -3,12 +3,16 @@
 // here, so checking a configuration never touches the network and needs no DDS. Whoever opens a
 // socket or a locator resolves the host (Endpoint::parse, apply_discovery).
 //
-// Like every check of text a user typed, each function returns what is wrong, in words for that
-// user, or "" when the value is fine: the form CLI11 validators and GatewayConfig's keys take.
+// Like every parser of text a user typed, each function returns a wire::Parsed: the value, or what
+// is wrong in words for that user (`.error()`, "" when fine, is what CLI11 validators and
+// GatewayConfig's key checks take).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
+
+#include "rsg/wire/parsed.hpp"
 
 namespace rsg::transport {
 
@@ -26,19 +30,22 @@ enum class HostPortRule {
 };
 
 /// Splits `value` into host and port by `rule`.
-/// @return what is wrong with `value`, or "" with `out` filled in.
-std::string split_host_port(std::string_view value, HostPortRule rule, HostPort& out);
+/// @return the host and port, or what is wrong with `value`.
+wire::Parsed<HostPort> parse_host_port(std::string_view value, HostPortRule rule);
 
-/// A Fast DDS Discovery Server, "[ID@]HOST:PORT" with ID 0..255.
-/// @return what is wrong, or "" with `out` filled in and `id` set when `value` names one (left
-/// alone otherwise).
-std::string split_discovery_server(std::string_view value, unsigned& id, HostPort& out);
+/// A Fast DDS Discovery Server as a user names it, "[ID@]HOST:PORT".
+struct DiscoveryServer {
+  std::optional<unsigned> id;  ///< 0..255 when given; else the server's position in the list
+  HostPort address;
+};
 
-/// @return what is wrong with `value` as [ID@]HOST:PORT, or "".
-std::string check_discovery_server(const std::string& value);
+/// Parses "[ID@]HOST:PORT" with ID 0..255.
+/// @return the server, or what is wrong with `value`.
+wire::Parsed<DiscoveryServer> parse_discovery_server(std::string_view value);
 
-/// @return what is wrong with `value` as a discovery peer, HOST[:PORT], or "".
-std::string check_peer(const std::string& value);
+/// Parses a discovery peer, HOST[:PORT].
+/// @return the peer (port 0 when none was given), or what is wrong with `value`.
+wire::Parsed<HostPort> parse_peer(std::string_view value);
 
 /// How many participant ids the gateway picks from (its pid modulo this), and so how many ports a
 /// bare-HOST peer is tried on: 60 keeps every domain's ports below 65536.

@@ -14,14 +14,16 @@
 #include <string_view>
 #include <vector>
 
+#include "rsg/error.hpp"
+
 namespace rsg::transport {
 
 /// An IPv4 or IPv6 address and port.
 class Endpoint {
  public:
   Endpoint() = default;
-  /// Parses "HOST:PORT" or "[V6]:PORT"; HOST may be a name. Throws std::invalid_argument with a
-  /// message that names the input.
+  /// Parses "HOST:PORT" or "[V6]:PORT"; HOST may be a name (resolved here).
+  /// @throws rsg::InputError naming the input when it is malformed or the name does not resolve.
   static Endpoint parse(std::string_view host_port);
 
   const sockaddr* address() const { return reinterpret_cast<const sockaddr*>(&storage_); }
@@ -84,9 +86,11 @@ class DatagramBatch {
 
 class UdpSocket {
  public:
-  /// A socket bound to `local` (port 0 picks a free one). Throws std::system_error naming the address.
+  /// A socket bound to `local` (port 0 picks a free one).
+  /// @throws rsg::EnvironmentError naming the address when the kernel refuses (e.g. in use).
   static UdpSocket bind(const Endpoint& local);
   /// An unbound socket of the family of `peer`, for sending.
+  /// @throws rsg::EnvironmentError when the kernel refuses a socket.
   static UdpSocket for_sending_to(const Endpoint& peer);
 
   UdpSocket(UdpSocket&& other) noexcept;

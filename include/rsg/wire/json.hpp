@@ -4,6 +4,7 @@
 #include <string>
 #include <string_view>
 
+#include "rsg/wire/parsed.hpp"
 #include "rsg/wire/state_values.hpp"
 
 namespace rsg::wire {
@@ -13,8 +14,9 @@ namespace rsg::wire {
 void append_canonical_json(const StateValues& values, std::string& out);
 std::string to_canonical_json(const StateValues& values);
 
-/// Reads one canonical JSON object. Returns false and a readable reason in `error` for malformed
-/// JSON, unknown fields, wrong shapes or values out of range; `fields` must match the selection.
-bool parse_canonical_json(std::string_view text, StateValues& out, std::string& error);
+/// Reads one canonical JSON object; `fields` must match the selection.
+/// @return the values, or a readable failure for malformed JSON, unknown fields, wrong shapes or
+/// values out of range.
+Parsed<StateValues> parse_canonical_json(std::string_view text);
 
 }  // namespace rsg::wire

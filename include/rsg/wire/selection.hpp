@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "rsg/wire/field_table.hpp"
+#include "rsg/wire/parsed.hpp"
 
 namespace rsg::wire {
 
@@ -47,11 +48,13 @@ struct Selection {
 };
 
 /// Parses a comma-separated list of field names ("q,dq,time") into a selection.
-/// On failure returns false and names the offending item in `error`.
-bool parse_field_list(std::string_view list, Selection& out, std::string& error);
+/// @return the selection, or a failure naming the offending item.
+Parsed<Selection> parse_field_list(std::string_view list);
 /// Parses a comma-separated list of group numbers ("0,2") into a selection of all their fields.
-bool parse_group_list(std::string_view list, Selection& out, std::string& error);
+/// @return the selection, or a failure naming the offending item.
+Parsed<Selection> parse_group_list(std::string_view list);
 /// Parses a group list into a group_select bit mask.
-bool parse_group_mask(std::string_view list, std::uint8_t& out, std::string& error);
+/// @return the mask, or a failure naming the offending item.
+Parsed<std::uint8_t> parse_group_mask(std::string_view list);
 
 }  // namespace rsg::wire

@@ -29,6 +29,7 @@
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/dds/ros2.hpp"
 #include "rsg/dds/views.hpp"
+#include "rsg/error.hpp"
 #include "rsg/wire/json.hpp"
 #include "rsg/wire/selection.hpp"
 #include "stop_on_signal.hpp"
@@ -138,7 +139,7 @@ void add_options(CLI::App& app, Options& options) {
       "--ros2", options.ros2,
       "Read what rsg_gateway --ros2 writes: topic rt/<ns>/<topic>, type rsg_msgs::msg::dds_::RobotState_");
   app.add_option("--ros2-namespace", options.ros2_namespace, "ROS 2 namespace with --ros2, e.g. /robot1")
-      ->check([](const std::string& ns) { return rsg::dds::check_ros2_namespace(ns); });
+      ->check([](const std::string& ns) { return rsg::dds::parse_ros2_namespace(ns).error(); });
   auto* view = app.add_option("--view", options.view_profile,
                               "View profile, e.g. view_joints: only samples carrying its groups");
   auto* groups = app.add_option("--groups", options.groups,
@@ -168,11 +169,9 @@ void add_options(CLI::App& app, Options& options) {
 std::optional<rsg::dds::View> requested_view(const Options& options, const fdds::Subscriber& subscriber) {
   if (!options.view_profile.empty()) return rsg::dds::load_view(subscriber, options.view_profile);
   if (options.groups.empty()) return std::nullopt;
-  std::uint8_t mask = 0;
-  std::string error;
-  if (!rsg::wire::parse_group_mask(options.groups, mask, error))
-    throw rsg::dds::ViewError("--groups: " + error);
-  return rsg::dds::group_view(mask);
+  const rsg::wire::Parsed<std::uint8_t> mask = rsg::wire::parse_group_mask(options.groups);
+  if (!mask) throw rsg::dds::ViewError("--groups: " + mask.error());
+  return rsg::dds::group_view(*mask);
 }
 
 int run(const Options& options) {
@@ -195,7 +194,7 @@ int run(const Options& options) {
     reader = view_reader->get();
   } else {
     reader = subscriber.create_datareader(&topic, qos);
-    if (reader == nullptr) throw std::runtime_error("cannot create a reader on '" + topic_name + "'");
+    if (reader == nullptr) throw rsg::EnvironmentError("cannot create a reader on '" + topic_name + "'");
   }
   const std::string read_topic = view_reader ? view_reader->filtered_topic()->get_name() : topic_name;
 
@@ -280,7 +279,8 @@ int main(int argc, char** argv) {
   Options options;
   add_options(app, options);
   if (const auto stop = parse_command_line(app, argc, argv)) return *stop;
-  if (const auto stop = load_profiles("rsg_echo", options.profiles, options.participant_profile))
-    return *stop;
-  return run_reporting_errors("rsg_echo", [&] { return run(options); });
+  return run_reporting_errors("rsg_echo", [&] {
+    rsg::dds::load_profiles(options.profiles, options.participant_profile);
+    return run(options);
+  });
 }

@@ -38,18 +38,6 @@ void for_each_nonblank_line(std::istream& in, OnLine&& on_line) {
   }
 }
 
-/// Why `from_hex` refused `text`: the first non-hex character, else the odd digit count.
-std::string describe_bad_hex(std::string_view text) {
-  const std::size_t bad = text.find_first_not_of("0123456789abcdefABCDEF");
-  std::array<char, 96> message{};
-  if (bad != std::string_view::npos)
-    std::snprintf(message.data(), message.size(), "byte 0x%02x at column %zu is not a hex digit",
-                  static_cast<unsigned char>(text[bad]), bad + 1);
-  else
-    std::snprintf(message.data(), message.size(), "odd number of hex digits (%zu)", text.size());
-  return message.data();
-}
-
 std::string error_line(std::string_view category, std::string_view message) {
   // ordered_json keeps "error" first; replace, not throw, on bytes that are not UTF-8.
   const nlohmann::ordered_json line = {{"error", category}, {"message", message}};
@@ -97,16 +85,15 @@ int decode_binary(Streams streams) {
 }
 
 int decode_hex_lines(Streams streams) {
-  std::vector<std::uint8_t> bytes;
   wire::StateValues values;
   std::string json;
   for_each_nonblank_line(streams.in, [&](std::size_t number, std::string_view text) {
-    if (!wire::from_hex(text, bytes)) {
-      streams.out << error_line("bad_hex", "line " + std::to_string(number) + ": " + describe_bad_hex(text))
-                  << '\n';
+    const wire::Parsed<std::vector<std::uint8_t>> bytes = wire::from_hex(text);
+    if (!bytes) {
+      streams.out << error_line("bad_hex", "line " + std::to_string(number) + ": " + bytes.error()) << '\n';
       return true;
     }
-    const wire::DecodeResult result = wire::decode(bytes);
+    const wire::DecodeResult result = wire::decode(*bytes);
     if (!result) {
       streams.out << error_line(wire::to_string(result.error().category()), result.error().message()) << '\n';
       return true;
@@ -122,15 +109,15 @@ int decode_hex_lines(Streams streams) {
 
 int encode_json_lines(Streams streams, FrameFormat format) {
   int status = kExitOk;
-  wire::StateValues values;
-  std::string reason;
   std::array<std::uint8_t, wire::kMaxFrameBytes> frame{};
   for_each_nonblank_line(streams.in, [&](std::size_t number, std::string_view text) {
-    if (!wire::parse_canonical_json(text, values, reason)) {
-      streams.err << "error: line " << number << ": " << reason << '\n';
+    const wire::Parsed<wire::StateValues> parsed = wire::parse_canonical_json(text);
+    if (!parsed) {
+      streams.err << "error: line " << number << ": " << parsed.error() << '\n';
       status = kExitInvalid;
       return false;
     }
+    const wire::StateValues& values = *parsed;
     const wire::EncodeResult result =
         encode(values.packet_number, values.selection, values.storage(), wire::StateValues::layout(), frame);
     if (!result) {

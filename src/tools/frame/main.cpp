@@ -49,8 +49,9 @@ void add_selection(CLI::App& command, Options& options) {
   auto* choice = command.add_option_group("selection", "What the robot should send (exactly one)");
   auto parse_into = [&options](auto parse, const char* option) {
     return [&options, parse, option](const std::string& list) {
-      std::string error;
-      if (!parse(list, options.selection, error)) throw CLI::ValidationError(option, error);
+      const rsg::wire::Parsed<rsg::wire::Selection> selection = parse(list);
+      if (!selection) throw CLI::ValidationError(option, selection.error());
+      options.selection = *selection;
     };
   };
   choice->add_option_function<std::string>("--groups", parse_into(rsg::wire::parse_group_list, "--groups"),

@@ -362,7 +362,8 @@ int main(int argc, char** argv) {
         << "rsg_record: warning: this build has no ros2/rsg_msgs/msg/GatewayStatus.msg, so a --profile ros2 "
            "recording leaves '"
         << options.status_topic << "' out\n";
-  if (const auto stop = load_profiles("rsg_record", options.profiles, options.participant_profile))
-    return *stop;
-  return run_reporting_errors("rsg_record", [&] { return run(options, *profile); });
+  return run_reporting_errors("rsg_record", [&] {
+    rsg::dds::load_profiles(options.profiles, options.participant_profile);
+    return run(options, *profile);
+  });
 }

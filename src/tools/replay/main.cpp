@@ -24,6 +24,7 @@
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
+#include "rsg/error.hpp"
 #include "rsg/transport/udp_socket.hpp"
 #include "stop_on_signal.hpp"
 #include "tool_main.hpp"
@@ -95,7 +96,7 @@ class DdsOutput final : public Output {
                     ->create_datawriter_with_profile(participant_.robot_state_topic(options.topic),
                                                      options.writer_profile)) {
     if (writer_ == nullptr)
-      throw std::runtime_error("cannot create a writer with profile '" + options.writer_profile + "'");
+      throw rsg::EnvironmentError("cannot create a writer with profile '" + options.writer_profile + "'");
   }
   bool send(const rsg::RobotState& sample) override {
     if (writer_->write(const_cast<rsg::RobotState*>(&sample))) return true;

@@ -11,14 +11,16 @@
 
 #include "pcap_file.hpp"
 #include "replay.hpp"
+#include "rsg/error.hpp"
 #include "simulator.hpp"
+#include "tool_main.hpp"
 #include "udp_stream.hpp"
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitUsage = 2;
+using rsg::tools::kExitFailure;
+using rsg::tools::kExitOk;
+using rsg::tools::kExitUsage;
 
 // Set from the signal handler: the only state shared with it.
 std::atomic<bool> g_stop{false};
@@ -112,11 +114,10 @@ void add_options(CLI::App& app, Options& options, rsg::tools::sim::SimConfig& co
     app.add_option_function<std::string>(
         name,
         [&options, parse, name](const std::string& list) {
-          rsg::wire::Selection selection;
-          std::string error;
-          if (!parse(list, selection, error)) throw CLI::ValidationError(name, error);
+          const rsg::wire::Parsed<rsg::wire::Selection> selection = parse(list);
+          if (!selection) throw CLI::ValidationError(name, selection.error());
           options.base_selection =
-              rsg::tools::sim::unite(options.base_selection.value_or(rsg::wire::Selection{}), selection);
+              rsg::tools::sim::unite(options.base_selection.value_or(rsg::wire::Selection{}), *selection);
         },
         help);
   };
@@ -214,7 +215,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Simulated Franka Panda: streams SEND_BUF frames (docs/protocol.md) over UDP.", "rsg_sim"};
   app.footer(std::string(kScheduleHelp) +
              "\n\nRuns until --count/--duration or SIGINT/SIGTERM. Exit status: 0 success, 1 runtime "
-             "error (socket, file), 2 usage error.");
+             "error (socket, file), 2 usage error (flags, address, replay file).");
   Options options;
   rsg::tools::sim::SimConfig config;
   add_options(app, options, config);
@@ -227,7 +228,7 @@ int main(int argc, char** argv) {
   }
   config.pause = std::chrono::milliseconds(options.pause_ms);
 
-  try {
+  return rsg::tools::run_reporting_errors("rsg_sim", [&] {
     if (!options.replay_path.empty()) return run_replay(options);
     const rsg::transport::Endpoint peer = rsg::transport::Endpoint::parse(options.to);
     rsg::transport::UdpSocket socket = rsg::transport::UdpSocket::for_sending_to(peer);
@@ -237,7 +238,7 @@ int main(int argc, char** argv) {
     std::ofstream record;
     if (!options.record_path.empty()) {
       record.open(options.record_path);
-      if (!record) throw std::runtime_error("cannot write '" + options.record_path + "'");
+      if (!record) throw rsg::EnvironmentError("cannot write '" + options.record_path + "'");
       sim.record_to(&record);
     }
 
@@ -258,14 +259,11 @@ int main(int argc, char** argv) {
     if (!options.report_path.empty()) {
       std::ofstream report(options.report_path);
       report << sim.report().to_json() << "\n";
-      if (!report) throw std::runtime_error("cannot write '" + options.report_path + "'");
+      if (!report) throw rsg::EnvironmentError("cannot write '" + options.report_path + "'");
     }
     if (pcap) pcap->flush();
     if (record.is_open() && !record.flush())
-      throw std::runtime_error("cannot write '" + options.record_path + "'");
-  } catch (const std::exception& e) {
-    std::cerr << "rsg_sim: error: " << e.what() << "\n";
-    return kExitFailure;
-  }
-  return kExitOk;
+      throw rsg::EnvironmentError("cannot write '" + options.record_path + "'");
+    return kExitOk;
+  });
 }

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "pcap_file.hpp"
+#include "rsg/error.hpp"
 #include "rsg/wire/frame.hpp"
 #include "udp_stream.hpp"
 
@@ -20,7 +21,7 @@ std::uint16_t first_frame_port(const std::string& path) {
   capture::PcapReader reader(path);
   while (const auto packet = reader.next())
     if (wire::decode(packet->payload)) return packet->to.port;
-  throw std::runtime_error("'" + path + "' holds no valid SEND_BUF frame; name the port with --port");
+  throw InputError("'" + path + "' holds no valid SEND_BUF frame; name the port with --port");
 }
 
 }  // namespace
@@ -52,7 +53,7 @@ ReplayReport replay(const std::string& path, transport::UdpSocket& socket, const
       ++in_pass;
     }
     if (in_pass == 0)
-      throw std::runtime_error("'" + path + "' holds no datagram to port " + std::to_string(report.port));
+      throw InputError("'" + path + "' holds no datagram to port " + std::to_string(report.port));
     if (stop.load(std::memory_order_relaxed)) break;
     ++report.passes;
     if (!options.loop) break;

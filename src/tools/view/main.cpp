@@ -183,7 +183,8 @@ int main(int argc, char** argv) {
     std::cerr << "rsg_view: --listen: " << error.what() << '\n';
     return kExitUsage;
   }
-  if (const auto stop = load_profiles("rsg_view", options.profiles, options.participant_profile))
-    return *stop;
-  return run_reporting_errors("rsg_view", [&] { return run(options); });
+  return run_reporting_errors("rsg_view", [&] {
+    rsg::dds::load_profiles(options.profiles, options.participant_profile);
+    return run(options);
+  });
 }

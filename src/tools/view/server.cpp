@@ -18,6 +18,8 @@
 #include <thread>
 #include <variant>
 
+#include "rsg/error.hpp"
+
 namespace rsg::tools::view {
 namespace {
 
@@ -394,7 +396,7 @@ Server::Server(const ServerOptions& options, std::vector<foxglove::Channel> chan
   }
   beast::error_code ec;
   const auto address = net::ip::make_address(options.host, ec);
-  if (ec) throw std::runtime_error("--listen: '" + options.host + "' is no IP address");
+  if (ec) throw InputError("--listen: '" + options.host + "' is no IP address");
   const tcp::endpoint endpoint(address, options.port);
   auto& acceptor = impl_->acceptor;
   acceptor.open(endpoint.protocol(), ec);
@@ -402,8 +404,8 @@ Server::Server(const ServerOptions& options, std::vector<foxglove::Channel> chan
   if (!ec) acceptor.bind(endpoint, ec);
   if (!ec) acceptor.listen(net::socket_base::max_listen_connections, ec);
   if (ec)
-    throw std::runtime_error("cannot listen on " + options.host + ":" + std::to_string(options.port) + ": " +
-                             ec.message());
+    throw EnvironmentError("cannot listen on " + options.host + ":" + std::to_string(options.port) + ": " +
+                           ec.message());
   impl_->accept();
   impl_->thread = std::thread([impl = impl_.get()] { impl->io.run(); });
 }
