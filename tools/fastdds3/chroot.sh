@@ -1,0 +1,110 @@
+#!/usr/bin/env bash
+# The Debian 13 (trixie) test bed of the Fast DDS 3 build (docs/fastdds-versions.md).
+#
+#   tools/fastdds3/chroot.sh setup         make the chroot once (cached), install docker/packages/trixie.txt
+#   tools/fastdds3/chroot.sh run CMD...    run CMD on the host with the chroot's file systems mounted
+#   tools/fastdds3/chroot.sh in CMD...     run CMD inside the chroot (cwd: the checkout, same path)
+#
+# The chroot lives in the git-ignored $RSG_TRIXIE_DIR (default .deps/trixie). `run` and `in` work in
+# a private mount namespace (unshare -m): /proc, /sys, /dev, /dev/shm and the checkout are mounted
+# into the chroot there only, are never seen by the host's other processes, unmounted by the trap
+# below and in any case by the kernel when the namespace's last process ends. So an `rm -rf` of the
+# chroot from outside never walks into a bind mount. The chroot shares the host's network (the
+# cross-version tests put a 2.9 process on the host and a 3.x process in the chroot on one domain).
+set -euo pipefail
+checkout=$(cd "$(dirname "$0")/../.." && pwd)
+root=${RSG_TRIXIE_DIR:-$checkout/.deps/trixie}
+mirror=${RSG_TRIXIE_MIRROR:-http://deb.debian.org/debian}
+packages_file=$checkout/docker/packages/trixie.txt
+
+die() { echo "chroot.sh: $*" >&2; exit 1; }
+[[ $(id -u) == 0 ]] || die "needs root (debootstrap, chroot, mount)"
+
+# Fails when anything is still mounted below $1 in this mount namespace.
+assert_unmounted() {
+  if findmnt -rn -o TARGET | grep -q "^$1/"; then die "$1 still has mounts: not touching it"; fi
+}
+
+setup() {
+  if [[ ! -f $root/.rsg-debootstrap ]]; then
+    assert_unmounted "$root.tmp"
+    rm -rf "$root.tmp"
+    command -v debootstrap >/dev/null || die "debootstrap missing: apt-get install debootstrap"
+    echo "chroot.sh: debootstrap trixie into $root (once)"
+    debootstrap --variant=minbase trixie "$root.tmp" "$mirror" > "$checkout/.deps/trixie-debootstrap.log" 2>&1 ||
+      die "debootstrap failed: $checkout/.deps/trixie-debootstrap.log"
+    touch "$root.tmp/.rsg-debootstrap"
+    assert_unmounted "$root"
+    rm -rf "$root"
+    mv "$root.tmp" "$root"
+  fi
+  local stamp
+  stamp=$(sha256sum "$packages_file" | cut -d' ' -f1)
+  if [[ ! -f $root/.rsg-packages || $(<"$root/.rsg-packages") != "$stamp" ]]; then
+    local packages
+    packages=$(grep -v '^\s*#' "$packages_file" | xargs)
+    echo "chroot.sh: installing into the chroot: $packages"
+    in_chroot sh -c "apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+      --no-install-recommends $packages > /tmp/rsg-apt.log 2>&1 || { tail -30 /tmp/rsg-apt.log; exit 1; }"
+    echo "$stamp" > "$root/.rsg-packages"
+  fi
+}
+
+# Mounts (in the current, private, mount namespace) and unmounts on exit, in reverse order.
+mounted=()
+unmount_all() {
+  local i
+  for ((i = ${#mounted[@]} - 1; i >= 0; i--)); do umount "${mounted[i]}" 2>/dev/null || umount -l "${mounted[i]}" || true; done
+}
+mount_all() {
+  trap unmount_all EXIT
+  local target
+  mount --make-rprivate /
+  for spec in "proc proc" "sysfs sys" "bind dev" "bind dev/shm" "bind dev/pts" "bind $checkout"; do
+    set -- $spec
+    case $1 in
+      proc) target=$root/proc; mount -t proc proc "$target" ;;
+      sysfs) target=$root/sys; mount -t sysfs sysfs "$target" ;;
+      bind)
+        local source=/${2#/}
+        target=$root$source
+        mkdir -p "$target"
+        mount --bind "$source" "$target"
+        ;;
+    esac
+    mounted+=("$target")
+  done
+  cp /etc/resolv.conf "$root/etc/resolv.conf" 2>/dev/null || true
+}
+
+# CMD inside the chroot, in a mount namespace of its own.
+in_chroot() {
+  if [[ ${RSG_TRIXIE_MOUNTED:-} != "$root" ]]; then
+    exec_in_namespace in "$@"
+    return
+  fi
+  chroot "$root" /usr/bin/env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
+    LANG=C.UTF-8 CCACHE_DIR="${CCACHE_DIR:-$checkout/.cache/ccache-trixie}" CCACHE_BASEDIR="$checkout" \
+    CCACHE_NOHASHDIR=true ${CI:+CI=$CI} \
+    sh -c 'cd "$0" && exec "$@"' "$checkout" "$@"
+}
+
+exec_in_namespace() {
+  unshare --mount --propagation private -- env RSG_TRIXIE_MOUNTED="$root" "$0" __mounted "$@"
+}
+
+case ${1:-} in
+  setup) setup ;;
+  run | in)
+    setup
+    exec_in_namespace "$@"
+    ;;
+  __mounted)
+    shift
+    mount_all
+    mode=$1
+    shift
+    if [[ $mode == in ]]; then in_chroot "$@"; else RSG_TRIXIE_ROOT=$root "$@"; fi
+    ;;
+  *) die "usage: $0 setup | run CMD... | in CMD..." ;;
+esac
