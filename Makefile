@@ -114,7 +114,13 @@ format:
 	git ls-files '*.cpp' '*.hpp' '*.h' '*.c' | xargs clang-format -i
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) $(DEMO_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) $(DEMO_BUILD) build-fdds3
+
+# Fast DDS 3 (Debian 13's 3.1.2) in a cached trixie chroot, and across versions with $(BUILD)'s
+# 2.9.1 on the host (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/.
+.PHONY: test-fastdds3
+test-fastdds3: build
+	JOBS=$(JOBS) tests/fastdds3/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds3.log
 
 # The container image (docs/container.md) with the engine that works here: Docker when `docker info`
 # answers, else podman with docker/containers.conf (docker/engine.sh). IMAGE names it.

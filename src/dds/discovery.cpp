@@ -1,8 +1,6 @@
 #include "rsg/dds/discovery.hpp"
 
 #include <arpa/inet.h>
-#include <fastdds/rtps/attributes/ServerAttributes.h>
-#include <fastrtps/utils/IPLocator.h>
 #include <netdb.h>
 
 #include <memory>
@@ -13,8 +11,8 @@
 namespace rsg::dds {
 namespace {
 
-using eprosima::fastrtps::rtps::IPLocator;
-using eprosima::fastrtps::rtps::Locator_t;
+using dds::rtps::IPLocator;
+using dds::rtps::Locator_t;
 
 std::string resolve_ipv4(const std::string& host, const std::string& value) {
   addrinfo hints{};
@@ -46,18 +44,14 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
     if (!parsed) throw InputError(parsed.error());
     const unsigned id = parsed->id.value_or(static_cast<unsigned>(index));
     const transport::HostPort& server = parsed->address;
-    eprosima::fastdds::rtps::RemoteServerAttributes remote;
-    eprosima::fastdds::rtps::get_server_client_default_guidPrefix(static_cast<int>(id), remote.guidPrefix);
-    remote.metatrafficUnicastLocatorList.push_back(
-        udp_locator(resolve_ipv4(server.host, value), server.port));
-    builtin.discovery_config.m_DiscoveryServers.push_back(remote);
+    dds::add_discovery_server(qos, id, udp_locator(resolve_ipv4(server.host, value), server.port));
   }
   if (!options.servers.empty()) {
-    builtin.discovery_config.discoveryProtocol = eprosima::fastrtps::rtps::DiscoveryProtocol_t::CLIENT;
+    builtin.discovery_config.discoveryProtocol = rsg::dds::DiscoveryProtocol::CLIENT;
     // Fast DDS's 450 ms cycle made a gateway's first sample reach a reader ~1.1 s after start; at
     // 50 ms (with xml_profiles/discovery_server/ on the server) it is ~0.4 s, same traffic once matched.
     builtin.discovery_config.discoveryServer_client_syncperiod =
-        eprosima::fastrtps::Duration_t(0, 50'000'000);
+        rsg::dds::Duration(0, 50'000'000);
   }
 
   if (!options.empty()) {
@@ -66,7 +60,7 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
     // (60 for a bare HOST), and a client asks its server again every 50 ms until it answers: keep
     // Fast DDS's period.
     builtin.discovery_config.leaseDuration_announcementperiod =
-        eprosima::fastrtps::rtps::DiscoverySettings().leaseDuration_announcementperiod;
+        rsg::dds::rtps::DiscoverySettings().leaseDuration_announcementperiod;
   }
 
   const auto& ports = qos.wire_protocol().port;

@@ -2,7 +2,6 @@
 
 #include <RobotStatePubSubTypes.h>
 #include <RobotStateTypeObject.h>
-#include <fastrtps/types/TypeObjectFactory.h>
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <stdexcept>
@@ -27,7 +26,7 @@ fdds::DomainParticipantQos profile_qos(const std::string& profile) {
   fdds::DomainParticipantQos qos;
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   if (profile.empty()) return factory->get_default_participant_qos();
-  if (factory->get_participant_qos_from_profile(profile, qos) != ReturnCode_t::RETCODE_OK)
+  if (factory->get_participant_qos_from_profile(profile, qos) != kOk)
     throw InputError("no participant profile named '" + profile + "' (are the XML profiles loaded?)");
   return qos;
 }
@@ -55,10 +54,9 @@ Participant::~Participant() {
 }
 
 fdds::Topic* Participant::topic(const std::string& name, fdds::TypeSupport type) {
-  if (auto* existing = participant_->find_topic(name, eprosima::fastrtps::Duration_t(0, 0))) return existing;
-  type->auto_fill_type_information(false);
-  type->auto_fill_type_object(false);
-  if (participant_->register_type(type) != ReturnCode_t::RETCODE_OK)
+  if (auto* existing = participant_->find_topic(name, Duration(0, 0))) return existing;
+  announce_no_type_information(type);
+  if (participant_->register_type(type) != kOk)
     throw EnvironmentError("cannot register type " + type.get_type_name());
   fdds::Topic* created = participant_->create_topic(name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
   if (!created) throw EnvironmentError("cannot create topic '" + name + "'");
@@ -69,11 +67,7 @@ fdds::Topic* Participant::robot_state_topic(const std::string& name, const std::
   registerRobotStateTypes();  // the type object the DDS-SQL filter factory looks members up in
   fdds::TypeSupport type(new RobotStatePubSubType());
   if (!type_name.empty()) {
-    // The filter factory looks the type object up by the topic's type name.
-    auto* factory = eprosima::fastrtps::types::TypeObjectFactory::get_instance();
-    factory->add_type_object(type_name, rsg::GetRobotStateIdentifier(true), rsg::GetRobotStateObject(true));
-    factory->add_type_object(type_name, rsg::GetRobotStateIdentifier(false), rsg::GetRobotStateObject(false));
-    type->setName(type_name.c_str());
+    dds::rename_type(type, type_name);  // where the filter factory still finds its type object
   }
   return topic(name, type);
 }

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "rsg/dds/fastdds_compat.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::dds {
@@ -49,7 +50,7 @@ void load_profiles(const std::filesystem::path& file_or_dir) {
   if (files.empty()) throw InputError(file_or_dir.string() + ": no XML profiles found");
   auto* factory = eprosima::fastdds::dds::DomainParticipantFactory::get_instance();
   for (const auto& file : files)
-    if (factory->load_XML_profiles_file(file.string()) != ReturnCode_t::RETCODE_OK)
+    if (factory->load_XML_profiles_file(file.string()) != kOk)
       throw InputError(file.string() +
                        ": Fast DDS rejected this XML profile file (its log above says where)");
 }
@@ -59,7 +60,7 @@ void load_profiles(const std::vector<std::string>& files_or_dirs, const std::str
   for (const auto& file_or_dir : files_or_dirs) load_profiles(file_or_dir);
   eprosima::fastdds::dds::DomainParticipantQos unused;
   if (eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
-          participant_profile, unused) != ReturnCode_t::RETCODE_OK)
+          participant_profile, unused) != kOk)
     throw InputError("no participant profile named '" + participant_profile + "'");
 }
 

@@ -1,7 +1,5 @@
 #include "rsg/dds/views.hpp"
 
-#include <fastdds/rtps/attributes/PropertyPolicy.h>
-
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 
 #include "rsg/error.hpp"
@@ -12,7 +10,7 @@ namespace rsg::dds {
 namespace fdds = eprosima::fastdds::dds;
 namespace {
 
-using eprosima::fastrtps::rtps::PropertyPolicyHelper;
+using dds::rtps::PropertyPolicyHelper;
 
 constexpr std::uint8_t kValidGroupBits = (1U << wire::kGroupCount) - 1;
 
@@ -84,7 +82,7 @@ View parse_view(const std::string& profile, const fdds::DataReaderQos& qos) {
 
 fdds::DataReaderQos load_reader_qos(const fdds::Subscriber& subscriber, const std::string& profile) {
   fdds::DataReaderQos qos;
-  if (subscriber.get_datareader_qos_from_profile(profile, qos) != ReturnCode_t::RETCODE_OK)
+  if (subscriber.get_datareader_qos_from_profile(profile, qos) != rsg::dds::kOk)
     throw ViewError("profile '" + profile + "': no such data_reader profile (are the XML profiles loaded?)");
   return qos;
 }

@@ -15,7 +15,7 @@ namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 // How long the thread sleeps without samples before it looks at its log again.
-const eprosima::fastrtps::Duration_t kIdleWake{1, 0};
+const rsg::dds::Duration kIdleWake{1, 0};
 
 }  // namespace
 
@@ -64,7 +64,7 @@ void Egress::forward_available() {
   FASTDDS_SEQUENCE(RobotStateSeq, RobotState);
   RobotStateSeq samples;
   fdds::SampleInfoSeq infos;
-  while (reader_->take(samples, infos) == ReturnCode_t::RETCODE_OK) {
+  while (reader_->take(samples, infos) == rsg::dds::kOk) {
     for (fdds::LoanableCollection::size_type i = 0; i < samples.length(); ++i)
       if (infos[i].valid_data) forward(samples[i]);
     reader_->return_loan(samples, infos);

@@ -1,9 +1,5 @@
 #include "gateway.hpp"
 
-#include <fastrtps/attributes/ParticipantAttributes.h>
-#include <fastrtps/attributes/PublisherAttributes.h>
-#include <fastrtps/attributes/SubscriberAttributes.h>
-#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
@@ -25,8 +21,6 @@ namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 using std::chrono::milliseconds;
-using XMLProfiles = eprosima::fastrtps::xmlparser::XMLProfileManager;
-using eprosima::fastrtps::xmlparser::XMLP_ret;
 
 constexpr auto kStatusPeriod = std::chrono::seconds(1);
 constexpr auto kSummaryPeriod = std::chrono::seconds(10);
@@ -47,23 +41,20 @@ void load_and_check_profiles(const GatewayConfig& config) {
   dds::load_profiles(profiles);
 
   // Fast DDS only notices a missing profile when an entity is created from it; look first.
-  eprosima::fastrtps::ParticipantAttributes participant;
-  eprosima::fastrtps::PublisherAttributes writer;
-  eprosima::fastrtps::SubscriberAttributes reader;
   const auto require = [&](bool found, const std::string& kind, const std::string& name) {
     if (!found) throw InputError(profiles.string() + ": no " + kind + " profile named '" + name + "'");
   };
-  require(XMLProfiles::fillParticipantAttributes(config.participant_profile, participant, false) ==
-              XMLP_ret::XML_OK,
-          "participant", config.participant_profile);
-  require(XMLProfiles::fillPublisherAttributes(config.status_profile, writer, false) == XMLP_ret::XML_OK,
-          "data_writer", config.status_profile);
+  using dds::ProfileKind;
+  require(dds::profile_defined(ProfileKind::kParticipant, config.participant_profile), "participant",
+          config.participant_profile);
+  require(dds::profile_defined(ProfileKind::kDataWriter, config.status_profile), "data_writer",
+          config.status_profile);
   if (config.has_ingress())
-    require(XMLProfiles::fillPublisherAttributes(config.writer_profile, writer, false) == XMLP_ret::XML_OK,
-            "data_writer", config.writer_profile);
+    require(dds::profile_defined(ProfileKind::kDataWriter, config.writer_profile), "data_writer",
+            config.writer_profile);
   if (config.has_egress())
-    require(XMLProfiles::fillSubscriberAttributes(config.reader_profile, reader, false) == XMLP_ret::XML_OK,
-            "data_reader", config.reader_profile);
+    require(dds::profile_defined(ProfileKind::kDataReader, config.reader_profile), "data_reader",
+            config.reader_profile);
 }
 
 // A gateway restarted after a crash must not come back on its predecessor's ports: readers still
@@ -75,7 +66,7 @@ fdds::DomainParticipantQos participant_qos(const GatewayConfig& config) {
   const std::string& profile = config.participant_profile;
   fdds::DomainParticipantQos qos;
   if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(profile, qos) !=
-      ReturnCode_t::RETCODE_OK)
+      dds::kOk)
     throw InputError("no participant profile named '" + profile + "'");
   if (qos.wire_protocol().participant_id < 0)
     qos.wire_protocol().participant_id =

@@ -33,7 +33,7 @@ class SampleSlot {
     // CPU at 1 kHz. Without a loan (type not plain, every loanable slot in use): the fallback.
     if (loans &&
         writer_.loan_sample(loan_, fdds::DataWriter::LoanInitializationKind::NO_LOAN_INITIALIZATION) ==
-            ReturnCode_t::RETCODE_OK)
+            rsg::dds::kOk)
       sample_ = static_cast<RobotState*>(loan_);
   }
   ~SampleSlot() {
@@ -95,7 +95,7 @@ Ingress::Ingress(dds::Participant& participant, Options options)
   if (options_.standard_topics && options_.standard_topics->any())
     standard_topics_.emplace(participant_, *publisher_, *options_.standard_topics);
   // Loans need a plain type; RobotState is one, but a profile could still make writes non-loanable.
-  writer_loans_ = writer_->get_type()->is_plain();
+  writer_loans_ = dds::is_plain(*writer_->get_type());
 }
 
 // The members' owners delete the standard topics' writers (after their thread), the rate writers,

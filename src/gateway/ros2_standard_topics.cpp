@@ -29,7 +29,7 @@ fdds::DataWriterQos writer_qos(const fdds::Publisher& publisher) {
   qos.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
   qos.history().depth = 100;
   // Variable-size samples: history slots grow to what is written, not to the type's bound.
-  qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+  qos.endpoint().history_memory_policy = rsg::dds::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   return qos;
 }
 

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rsg/dds/fastdds_compat.hpp"
 #include "rsg_ros2_type_hashes.hpp"
 
 namespace rsg::gateway {
@@ -41,7 +42,7 @@ inline void announce_ros2_type_hash(eprosima::fastdds::dds::UserDataQosPolicy& u
   const std::string_view hash = ros2_type_hash(type_name);
   if (hash.empty()) return;
   const std::string text = "typehash=" + std::string(hash) + ";";
-  user_data.setValue(std::vector<eprosima::fastrtps::rtps::octet>(text.begin(), text.end()));
+  user_data.setValue(std::vector<rsg::dds::rtps::octet>(text.begin(), text.end()));
 }
 
 /// create_datawriter_with_profile, with the topic type's hash announced when it has one.
@@ -51,7 +52,7 @@ inline eprosima::fastdds::dds::DataWriter* create_writer_with_profile(
   eprosima::fastdds::dds::DataWriterQos qos;
   if (ros2_type_hash(topic->get_type_name()).empty() ||
       publisher.get_datawriter_qos_from_profile(profile, qos) !=
-          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+          rsg::dds::kOk)
     return publisher.create_datawriter_with_profile(topic, profile);
   announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
   return publisher.create_datawriter(topic, qos);
@@ -64,7 +65,7 @@ inline eprosima::fastdds::dds::DataReader* create_reader_with_profile(
   eprosima::fastdds::dds::DataReaderQos qos;
   if (ros2_type_hash(topic->get_type_name()).empty() ||
       subscriber.get_datareader_qos_from_profile(profile, qos) !=
-          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+          rsg::dds::kOk)
     return subscriber.create_datareader_with_profile(topic, profile);
   announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
   return subscriber.create_datareader(topic, qos);

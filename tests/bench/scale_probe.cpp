@@ -56,7 +56,7 @@ class ArrivalLog : public fdds::DataReaderListener {
     const std::int64_t received_ns = monotonic_ns();
     fdds::LoanableSequence<rsg::RobotState> samples;
     fdds::SampleInfoSeq infos;
-    while (reader->take(samples, infos) == ReturnCode_t::RETCODE_OK) {
+    while (reader->take(samples, infos) == rsg::dds::kOk) {
       for (fdds::LoanableCollection::size_type i = 0; i < samples.length(); ++i) {
         const std::size_t at = count_.load(std::memory_order_relaxed);
         if (!infos[i].valid_data || at == arrivals_.size()) continue;

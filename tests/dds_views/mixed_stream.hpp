@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "random_state.hpp"
+#include "rsg/dds/fastdds_compat.hpp"
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/state_values.hpp"
 
@@ -60,7 +61,7 @@ inline bool wait_for_matched_readers(eprosima::fastdds::dds::DataWriter& writer,
     writer.get_publication_matched_status(status);
     if (status.current_count >= readers) return status.current_count == readers;
     fdds::ConditionSeq triggered;
-    waitset.wait(triggered, eprosima::fastrtps::Duration_t(1, 0));
+    waitset.wait(triggered, rsg::dds::Duration(1, 0));
   }
   return false;
 }

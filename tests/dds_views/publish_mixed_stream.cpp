@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
   // It starts once it has matched its readers, but a reader may match it later (discovery is not
   // symmetric): a transient-local reader then still gets the whole stream from the history.
   qos.durability().kind = fdds::TRANSIENT_LOCAL_DURABILITY_QOS;
-  qos.deadline().period = eprosima::fastrtps::Duration_t(0, 100'000'000);  // like the gateway's
+  qos.deadline().period = rsg::dds::Duration(0, 100'000'000);  // like the gateway's
   fdds::DataWriter* writer = publisher.create_datawriter(participant.robot_state_topic(topic_name), qos);
   if (writer == nullptr || !rsg::test::wait_for_matched_readers(*writer, readers)) {
     std::cerr << "rsg_views_publish: the readers did not match\n";
@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
     std::this_thread::sleep_until(next += period);
   }
   out.close();
-  if (writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(60, 0)) != ReturnCode_t::RETCODE_OK) {
+  if (writer->wait_for_acknowledgments(rsg::dds::Duration(60, 0)) != rsg::dds::kOk) {
     std::cerr << "rsg_views_publish: not every reader acknowledged the stream\n";
     return 1;
   }

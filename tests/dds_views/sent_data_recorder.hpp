@@ -3,20 +3,31 @@
 // Where a content filter is evaluated is invisible in the DDS API; this makes it countable.
 #pragma once
 
-#include <fastdds/rtps/transport/ChainingTransport.h>
-#include <fastdds/rtps/transport/ChainingTransportDescriptor.h>
-#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
-
 #include <cstdint>
 #include <cstring>
 #include <memory>
 #include <mutex>
 #include <set>
+#include <vector>
+
+#include "rsg/dds/fastdds_compat.hpp"
+
+// The transport API is the one place of rsg's tests where Fast DDS 2 and 3 differ beyond names:
+// 3.x hands a message over as a list of buffers (and renamed the headers).
+#if RSG_FASTDDS_MAJOR >= 3
+#include <fastdds/rtps/transport/ChainingTransport.hpp>
+#include <fastdds/rtps/transport/ChainingTransportDescriptor.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.hpp>
+#else
+#include <fastdds/rtps/transport/ChainingTransport.h>
+#include <fastdds/rtps/transport/ChainingTransportDescriptor.h>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#endif
 
 namespace rsg::test {
 
 namespace ftransport = eprosima::fastdds::rtps;
-namespace frtps = eprosima::fastrtps::rtps;
+namespace frtps = rsg::dds::rtps;
 
 /// The writer sequence numbers seen so far, shared between the test and Fast DDS's send threads.
 class SentSamples {
@@ -83,12 +94,28 @@ class SentDataRecordingTransport : public ftransport::ChainingTransport {
 
   ftransport::TransportDescriptorInterface* get_configuration() override { return &descriptor_; }
 
+#if RSG_FASTDDS_MAJOR >= 3
+  bool send(frtps::SenderResource* low_sender_resource, const std::vector<frtps::NetworkBuffer>& buffers,
+            std::uint32_t total_bytes, frtps::LocatorsIterator* destinations_begin,
+            frtps::LocatorsIterator* destinations_end,
+            const std::chrono::steady_clock::time_point& timeout) override {
+    std::vector<std::uint8_t> message;
+    message.reserve(total_bytes);
+    for (const auto& buffer : buffers) {
+      const auto* bytes = static_cast<const std::uint8_t*>(buffer.buffer);
+      message.insert(message.end(), bytes, bytes + buffer.size);
+    }
+    record_user_data(message.data(), message.size(), *descriptor_.sent);
+    return low_sender_resource->send(buffers, total_bytes, destinations_begin, destinations_end, timeout);
+  }
+#else
   bool send(frtps::SenderResource* low_sender_resource, const frtps::octet* buffer, std::uint32_t size,
             frtps::LocatorsIterator* destinations_begin, frtps::LocatorsIterator* destinations_end,
             const std::chrono::steady_clock::time_point& timeout) override {
     record_user_data(buffer, size, *descriptor_.sent);
     return low_sender_resource->send(buffer, size, destinations_begin, destinations_end, timeout);
   }
+#endif
 
   void receive(ftransport::TransportReceiverInterface* next_receiver, const frtps::octet* buffer,
                std::uint32_t size, const frtps::Locator_t& local_locator,

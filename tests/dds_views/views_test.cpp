@@ -69,7 +69,7 @@ TEST_F(Views, FlavoursHaveTheDocumentedQos) {
   EXPECT_EQ(realtime.reliability().kind, fdds::BEST_EFFORT_RELIABILITY_QOS);
   EXPECT_EQ(realtime.history().kind, fdds::KEEP_LAST_HISTORY_QOS);
   EXPECT_EQ(realtime.history().depth, 1);
-  EXPECT_EQ(realtime.deadline().period, eprosima::fastrtps::Duration_t(0, 100'000'000));
+  EXPECT_EQ(realtime.deadline().period, dds::Duration(0, 100'000'000));
   const fdds::DataReaderQos logger = dds::load_reader_qos(subscriber, dds::kLoggerReaderProfile);
   EXPECT_EQ(logger.reliability().kind, fdds::RELIABLE_RELIABILITY_QOS);
   EXPECT_EQ(logger.history().kind, fdds::KEEP_LAST_HISTORY_QOS);
@@ -165,8 +165,8 @@ TEST_F(Views, ViewReadersReceiveExactlyTheSamplesCarryingAllTheirGroups) {
     dds::to_sample(values, sample);
     ASSERT_TRUE(writer->write(&sample));
   }
-  ASSERT_EQ(writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(60, 0)),
-            ReturnCode_t::RETCODE_OK);
+  ASSERT_EQ(writer->wait_for_acknowledgments(rsg::dds::Duration(60, 0)),
+            rsg::dds::kOk);
 
   for (Case& test_case : cases) {
     SCOPED_TRACE(test_case.reader->view().name);
@@ -177,7 +177,7 @@ TEST_F(Views, ViewReadersReceiveExactlyTheSamplesCarryingAllTheirGroups) {
 
     std::vector<std::size_t> received;
     fdds::SampleInfo info;
-    while (test_case.reader->get()->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+    while (test_case.reader->get()->take_next_sample(&sample, &info) == rsg::dds::kOk) {
       // Writer sequence numbers start at 1 and follow the write order.
       const auto index = static_cast<std::size_t>(info.sample_identity.sequence_number().to64long() - 1);
       ASSERT_LT(index, stream.size());

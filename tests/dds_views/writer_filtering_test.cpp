@@ -7,8 +7,6 @@
 // Two participants in one process, intra-process delivery off, so that the reader is remote to
 // the writer in every respect but the process.
 #include <RobotStatePubSubTypes.h>
-#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
-#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -53,9 +51,7 @@ struct Outcome {
 enum class Delivery { kUdp, kDataSharing };
 
 Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qos, Delivery delivery) {
-  eprosima::fastrtps::LibrarySettingsAttributes settings;
-  settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
-  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
+  dds::disable_intraprocess_delivery();
   dds::load_profiles(dds::default_profiles_dir());
   const int domain = static_cast<int>(::getpid() % 200 + 10);
 
@@ -101,13 +97,13 @@ Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qo
   // The waits are a guard against hanging (a minute), not a threshold.
   fdds::SampleInfo info;
   for (int waits = 0; waits < 60 && outcome.received.size() < outcome.accepted.size(); ++waits) {
-    reader->wait_for_unread_message(eprosima::fastrtps::Duration_t(1, 0));
-    while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK)
+    reader->wait_for_unread_message(rsg::dds::Duration(1, 0));
+    while (reader->take_next_sample(&sample, &info) == rsg::dds::kOk)
       outcome.received.insert(info.sample_identity.sequence_number().to64long());
   }
-  EXPECT_EQ(writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(60, 0)),
-            ReturnCode_t::RETCODE_OK);
-  while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK)  // nothing more may come
+  EXPECT_EQ(writer->wait_for_acknowledgments(rsg::dds::Duration(60, 0)),
+            rsg::dds::kOk);
+  while (reader->take_next_sample(&sample, &info) == rsg::dds::kOk)  // nothing more may come
     outcome.received.insert(info.sample_identity.sequence_number().to64long());
   outcome.sent = sent->sequence_numbers();
   return outcome;
@@ -132,8 +128,8 @@ TEST(WriterSideFiltering, WithoutReaderFilterSlotsTheWriterSendsEverything) {
 TEST(WriterSideFiltering, AWriterWithFiniteLivelinessSendsEverything) {
   fdds::DataWriterQos qos = fdds::DATAWRITER_QOS_DEFAULT;
   qos.liveliness().kind = fdds::AUTOMATIC_LIVELINESS_QOS;
-  qos.liveliness().lease_duration = eprosima::fastrtps::Duration_t(2, 0);
-  qos.liveliness().announcement_period = eprosima::fastrtps::Duration_t(1, 0);
+  qos.liveliness().lease_duration = rsg::dds::Duration(2, 0);
+  qos.liveliness().announcement_period = rsg::dds::Duration(1, 0);
   const Outcome outcome = publish_mixed_stream_to_a_view(qos, Delivery::kUdp);
   EXPECT_EQ(outcome.sent.size(), outcome.written);
   EXPECT_EQ(outcome.received, outcome.accepted) << "the reader must filter instead";
@@ -145,7 +141,7 @@ TEST(WriterSideFiltering, TheGatewayWriterProfileKeepsRejectedSamplesOffTheWire)
   dds::Participant any(static_cast<int>(::getpid() % 200 + 10), "");
   fdds::DataWriterQos gateway_qos;
   ASSERT_EQ(any.publisher()->get_datawriter_qos_from_profile("rsg_state_writer", gateway_qos),
-            ReturnCode_t::RETCODE_OK);
+            rsg::dds::kOk);
   const Outcome outcome = publish_mixed_stream_to_a_view(gateway_qos, Delivery::kUdp);
   ASSERT_LT(outcome.accepted.size(), outcome.written);
   EXPECT_EQ(outcome.sent, outcome.accepted) << "the gateway's writer put rejected samples on the wire";

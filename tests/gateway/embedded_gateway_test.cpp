@@ -3,8 +3,6 @@
 // frame, and nothing after stop(); an unusable configuration throws before anything starts.
 #include "rsg/gateway/embedded_gateway.hpp"
 
-#include <fastrtps/attributes/LibrarySettingsAttributes.h>
-#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -46,9 +44,7 @@ class EmbeddedGatewayTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     // The reader must get its samples over the network, as a reader in another process would.
-    eprosima::fastrtps::LibrarySettingsAttributes settings;
-    settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
-    eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
+    rsg::dds::disable_intraprocess_delivery();
   }
   const int domain_ = static_cast<int>(::getpid() % 200 + 10);
 };
@@ -99,7 +95,7 @@ TEST_F(EmbeddedGatewayTest, CallbackSeesExactlyWhatARemoteReaderReceives) {
   RobotState sample;
   fdds::SampleInfo info;
   for (int i = 0; i < 1000 && from_reader.size() < sent.size(); ++i) {
-    while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK)
+    while (reader->take_next_sample(&sample, &info) == rsg::dds::kOk)
       if (info.valid_data) from_reader.push_back(frame_of(sample));
     if (from_reader.size() < sent.size()) std::this_thread::sleep_for(10ms);
   }

@@ -14,7 +14,6 @@
 // BEST_EFFORT (a StatelessWriter) it asserts that nothing at all is allocated.
 //
 // Counts through tests/support/allocation_counter.hpp: a binary of its own, outside the sanitizer build.
-#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -92,15 +91,13 @@ class IngressAllocation : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     // No intra-process shortcut: the writes must really reach the other participant.
-    eprosima::fastrtps::LibrarySettingsAttributes settings;
-    settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
-    eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
+    dds::disable_intraprocess_delivery();
     dds::load_profiles(std::filesystem::path(RSG_PROFILES_DIR) / "gateway.xml");
     // UDP only: Fast DDS 2.9's SHM transport allocates per send, which would hide rsg's own.
     dds::load_profiles(std::filesystem::path(RSG_TEST_DATA_DIR) / "hot_path_profiles.xml");
-    ASSERT_EQ(eprosima::fastrtps::xmlparser::XMLProfileManager::loadXMLString(kBestEffortProfile.data(),
-                                                                              kBestEffortProfile.size()),
-              eprosima::fastrtps::xmlparser::XMLP_ret::XML_OK);
+    ASSERT_EQ(eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->load_XML_profiles_string(
+                  kBestEffortProfile.data(), kBestEffortProfile.size()),
+              dds::kOk);
   }
 
   Ingress::Options options(const std::string& writer_profile) {
@@ -198,7 +195,7 @@ class IngressAllocation : public ::testing::Test {
 
     RobotState sample;
     fdds::SampleInfo info;
-    EXPECT_EQ(reader->take_next_sample(&sample, &info), ReturnCode_t::RETCODE_OK)
+    EXPECT_EQ(reader->take_next_sample(&sample, &info), rsg::dds::kOk)
         << "nothing reached the reader";
     subscribing_.subscriber()->delete_datareader(reader);
     if (check_after) check_after(ingress, sent);

@@ -42,8 +42,8 @@ int main(int argc, char** argv) {
   fdds::SampleInfo info;
   fdds::ConditionSeq triggered;
   while (std::chrono::steady_clock::now() < deadline) {
-    waitset.wait(triggered, eprosima::fastrtps::Duration_t(0, 200'000'000));
-    while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK)
+    waitset.wait(triggered, rsg::dds::Duration(0, 200'000'000));
+    while (reader->take_next_sample(&sample, &info) == rsg::dds::kOk)
       if (info.valid_data)
         std::cout << rsg::gateway::to_json(rsg::gateway::from_status_sample(sample)) << std::endl;
   }

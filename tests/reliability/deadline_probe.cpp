@@ -75,7 +75,7 @@ class StateListener : public fdds::DataReaderListener {
 
   void on_data_available(fdds::DataReader* reader) override {
     fdds::SampleInfo info;
-    while (reader->take_next_sample(&sample_, &info) == ReturnCode_t::RETCODE_OK)
+    while (reader->take_next_sample(&sample_, &info) == rsg::dds::kOk)
       if (info.valid_data)
         log_.add(timestamped("sample", ",\"packet_number\":" + std::to_string(sample_.packet_number()) +
                                            ",\"time\":" + std::to_string(sample_.time())));
@@ -97,7 +97,7 @@ class StatusListener : public fdds::DataReaderListener {
 
   void on_data_available(fdds::DataReader* reader) override {
     fdds::SampleInfo info;
-    while (reader->take_next_sample(&sample_, &info) == ReturnCode_t::RETCODE_OK) {
+    while (reader->take_next_sample(&sample_, &info) == rsg::dds::kOk) {
       if (!info.valid_data) continue;
       // The --stats-file object without its braces, appended after "t" and "event".
       const std::string json = rsg::gateway::to_json(rsg::gateway::from_status_sample(sample_));

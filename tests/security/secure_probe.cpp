@@ -58,7 +58,7 @@ namespace rsg::security_probe {
 namespace fdds = eprosima::fastdds::dds;
 namespace {
 
-namespace rtps = eprosima::fastrtps::rtps;
+namespace rtps = rsg::dds::rtps;
 
 /// The bytes "RSG-LEAK" read as a little-endian double: finite, and unlikely to occur by chance
 /// in ciphertext or in any other part of an RTPS message.
@@ -200,7 +200,7 @@ class ReaderEvents : public fdds::DataReaderListener {
 
   void on_data_available(fdds::DataReader* reader) override {
     fdds::SampleInfo info;
-    while (reader->take_next_sample(&sample_, &info) == ReturnCode_t::RETCODE_OK) {
+    while (reader->take_next_sample(&sample_, &info) == rsg::dds::kOk) {
       if (!info.valid_data) continue;
       wire::StateValues received;
       dds::to_values(sample_, received);
@@ -255,7 +255,7 @@ void enable_with_listener(dds::Participant& participant, ParticipantEvents& list
   // No status callbacks: with data_on_readers in its mask, a participant listener takes the data
   // that the readers' own listeners are waiting for. Discovery and authentication are unmasked.
   participant.get()->set_listener(&listener, fdds::StatusMask::none());
-  if (participant.get()->enable() != ReturnCode_t::RETCODE_OK)
+  if (participant.get()->enable() != rsg::dds::kOk)
     throw std::runtime_error("cannot enable the DDS participant");
 }
 

@@ -22,7 +22,8 @@ struct ThreadCounts {
 thread_local ThreadCounts counts;
 
 // The caller is the first frame outside this binary (operator new and everything inlined into
-// the code under test live in it); when that is libfastrtps, Fast DDS allocated.
+// the code under test live in it); when that is libfastrtps (2.x) or libfastdds (3.x), Fast DDS
+// allocated.
 bool called_from_fast_dds(void* const* frames, int depth) {
   Dl_info self{};
   ::dladdr(reinterpret_cast<void*>(&called_from_fast_dds), &self);
@@ -30,7 +31,8 @@ bool called_from_fast_dds(void* const* frames, int depth) {
     Dl_info frame{};
     if (!::dladdr(frames[i], &frame)) return false;
     if (frame.dli_fbase == self.dli_fbase) continue;
-    return frame.dli_fname && std::strstr(frame.dli_fname, "libfastrtps");
+    return frame.dli_fname &&
+           (std::strstr(frame.dli_fname, "libfastrtps") || std::strstr(frame.dli_fname, "libfastdds"));
   }
   return false;
 }

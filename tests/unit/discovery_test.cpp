@@ -1,6 +1,5 @@
 #include "rsg/dds/discovery.hpp"
 
-#include <fastrtps/utils/IPLocator.h>
 #include <gtest/gtest.h>
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -12,8 +11,8 @@ namespace rsg {
 namespace {
 
 namespace fdds = eprosima::fastdds::dds;
-using eprosima::fastrtps::rtps::DiscoveryProtocol_t;
-using eprosima::fastrtps::rtps::IPLocator;
+using rsg::dds::DiscoveryProtocol;
+using rsg::dds::rtps::IPLocator;
 
 dds::DiscoveryOptions servers(std::vector<std::string> values) {
   dds::DiscoveryOptions options;
@@ -27,29 +26,22 @@ dds::DiscoveryOptions peers(std::vector<std::string> values) {
   return options;
 }
 
-std::string prefix_of(const eprosima::fastdds::rtps::RemoteServerAttributes& server) {
-  std::ostringstream text;
-  text << server.guidPrefix;
-  return text.str();
-}
-
-// `fastdds discovery -i 0` prints "Server GUID prefix: 44.53.00.5f.45.50.52.4f.53.49.4d.41"; the
-// third byte is the id.
+// `fastdds discovery -i 0` (Fast DDS 2) prints "Server GUID prefix: 44.53.00.5f.45.50.52.4f.53.49.4d.41";
+// the third byte is the id. Fast DDS 3 finds servers by their locators alone.
 TEST(Discovery, ServersBecomeClientOfTheIdsFastddsDiscoveryUses) {
   fdds::DomainParticipantQos qos;
   dds::apply_discovery(servers({"198.18.0.2:11811", "198.18.0.3:11812", "7@198.18.0.4:11813"}), 0, qos);
   const auto& config = qos.wire_protocol().builtin.discovery_config;
-  EXPECT_EQ(config.discoveryProtocol, DiscoveryProtocol_t::CLIENT);
+  EXPECT_EQ(config.discoveryProtocol, DiscoveryProtocol::CLIENT);
   ASSERT_EQ(config.m_DiscoveryServers.size(), 3u);
-  const auto& first = config.m_DiscoveryServers.front();
-  EXPECT_EQ(prefix_of(first), "44.53.00.5f.45.50.52.4f.53.49.4d.41");
-  ASSERT_EQ(first.metatrafficUnicastLocatorList.size(), 1u);
-  const auto& locator = *first.metatrafficUnicastLocatorList.begin();
+  const auto locator = rsg::dds::discovery_server_locator(qos, 0);
   EXPECT_EQ(IPLocator::ip_to_string(locator), "198.18.0.2");
   EXPECT_EQ(locator.port, 11811u);
-  auto server = config.m_DiscoveryServers.begin();
-  EXPECT_EQ(prefix_of(*++server), "44.53.01.5f.45.50.52.4f.53.49.4d.41");
-  EXPECT_EQ(prefix_of(*++server), "44.53.07.5f.45.50.52.4f.53.49.4d.41");
+  EXPECT_EQ(IPLocator::ip_to_string(rsg::dds::discovery_server_locator(qos, 2)), "198.18.0.4");
+  if (RSG_FASTDDS_MAJOR >= 3) return;
+  EXPECT_EQ(rsg::dds::discovery_server_prefix(qos, 0), "44.53.00.5f.45.50.52.4f.53.49.4d.41");
+  EXPECT_EQ(rsg::dds::discovery_server_prefix(qos, 1), "44.53.01.5f.45.50.52.4f.53.49.4d.41");
+  EXPECT_EQ(rsg::dds::discovery_server_prefix(qos, 2), "44.53.07.5f.45.50.52.4f.53.49.4d.41");
 }
 
 TEST(Discovery, TheXmlExampleIsTheSameClient) {
@@ -57,14 +49,14 @@ TEST(Discovery, TheXmlExampleIsTheSameClient) {
   fdds::DomainParticipantQos from_xml;
   ASSERT_EQ(fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
                 "rsg_discovery_client", from_xml),
-            ReturnCode_t::RETCODE_OK);
+            rsg::dds::kOk);
   fdds::DomainParticipantQos from_flag;
   dds::apply_discovery(servers({"127.0.0.1:11811"}), 0, from_flag);
-  EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.discoveryProtocol, DiscoveryProtocol_t::CLIENT);
+  EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.discoveryProtocol, dds::DiscoveryProtocol::CLIENT);
   EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.m_DiscoveryServers,
             from_flag.wire_protocol().builtin.discovery_config.m_DiscoveryServers);
   // Both run the discovery cycle every 50 ms, not Fast DDS's 450 (docs/scaling.md).
-  const eprosima::fastrtps::Duration_t fifty_ms(0, 50'000'000);
+  const rsg::dds::Duration fifty_ms(0, 50'000'000);
   EXPECT_EQ(from_flag.wire_protocol().builtin.discovery_config.discoveryServer_client_syncperiod, fifty_ms);
   EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.discoveryServer_client_syncperiod, fifty_ms);
 }
@@ -79,20 +71,20 @@ TEST(Discovery, APeerWithoutPortCoversEveryGatewayParticipantId) {
   EXPECT_EQ((peers.begin() + 59)->port, 8160u + 2 * 59);
   EXPECT_EQ(IPLocator::ip_to_string(*(peers.begin() + 60)), "198.18.0.3");
   EXPECT_EQ((peers.begin() + 60)->port, 7412u);
-  EXPECT_EQ(qos.wire_protocol().builtin.discovery_config.discoveryProtocol, DiscoveryProtocol_t::SIMPLE);
+  EXPECT_EQ(qos.wire_protocol().builtin.discovery_config.discoveryProtocol, DiscoveryProtocol::SIMPLE);
 }
 
 // rsg_participant announces every 0.5 s (a late joiner's lost reply, xml_profiles/rsg.xml); with a
 // server or unicast peers every announcement goes to each of them, so those keep Fast DDS's 3 s.
 TEST(Discovery, MulticastAnnouncesEveryHalfSecondServersAndPeersAtFastDdsDefault) {
   dds::load_profiles(dds::default_profiles_dir());
-  const eprosima::fastrtps::Duration_t half_second(0, 500'000'000);
-  const auto fastdds_default = eprosima::fastrtps::rtps::DiscoverySettings().leaseDuration_announcementperiod;
+  const dds::Duration half_second(0, 500'000'000);
+  const auto fastdds_default = dds::rtps::DiscoverySettings().leaseDuration_announcementperiod;
   ASSERT_NE(fastdds_default, half_second);
   for (const char* profile : {"rsg_participant", "rsg_participant_multicast"}) {
     fdds::DomainParticipantQos qos;
     ASSERT_EQ(fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(profile, qos),
-              ReturnCode_t::RETCODE_OK);
+              rsg::dds::kOk);
     EXPECT_EQ(qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod, half_second)
         << profile;
     fdds::DomainParticipantQos multicast = qos;

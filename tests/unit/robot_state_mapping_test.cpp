@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "rsg/dds/fastdds_compat.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "vectors.hpp"
 
@@ -14,9 +15,9 @@ namespace {
 
 TEST(RobotStateType, IsPlainBoundedAndUnkeyed) {
   RobotStatePubSubType type;
-  EXPECT_TRUE(type.is_plain());
+  EXPECT_TRUE(rsg::dds::is_plain(type));
   EXPECT_TRUE(type.is_bounded());
-  EXPECT_FALSE(type.m_isGetKeyDefined);
+  EXPECT_FALSE(rsg::dds::is_keyed(type));
 }
 
 TEST(RobotStateType, MembersDoNotOverlap) {

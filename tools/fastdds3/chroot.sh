@@ -3,10 +3,13 @@
 #
 #   tools/fastdds3/chroot.sh setup         make the chroot once (cached), install docker/packages/trixie.txt
 #   tools/fastdds3/chroot.sh run CMD...    run CMD on the host with the chroot's file systems mounted
-#   tools/fastdds3/chroot.sh in CMD...     run CMD inside the chroot (cwd: the checkout, same path)
+#   tools/fastdds3/chroot.sh in CMD...     run CMD inside the chroot, in the same directory (the checkout
+#                                          is mounted at its own path; RSG_CHROOT_ENV="A=1 B=2" passes
+#                                          variables in)
 #
 # The chroot lives in the git-ignored $RSG_TRIXIE_DIR (default .deps/trixie). `run` and `in` work in
-# a private mount namespace (unshare -m): /proc, /sys, /dev, /dev/shm and the checkout are mounted
+# a private mount namespace (unshare -m): /proc, /sys, /dev, /dev/shm, /tmp (files the tests hand
+# over) and the checkout are mounted
 # into the chroot there only, are never seen by the host's other processes, unmounted by the trap
 # below and in any case by the kernel when the namespace's last process ends. So an `rm -rf` of the
 # chroot from outside never walks into a bind mount. The chroot shares the host's network (the
@@ -60,7 +63,7 @@ mount_all() {
   trap unmount_all EXIT
   local target
   mount --make-rprivate /
-  for spec in "proc proc" "sysfs sys" "bind dev" "bind dev/shm" "bind dev/pts" "bind $checkout"; do
+  for spec in "proc proc" "sysfs sys" "bind dev" "bind dev/shm" "bind dev/pts" "bind tmp" "bind $checkout"; do
     set -- $spec
     case $1 in
       proc) target=$root/proc; mount -t proc proc "$target" ;;
@@ -80,17 +83,28 @@ mount_all() {
 # CMD inside the chroot, in a mount namespace of its own.
 in_chroot() {
   if [[ ${RSG_TRIXIE_MOUNTED:-} != "$root" ]]; then
-    exec_in_namespace in "$@"
+    (exec_in_namespace in "$@")
     return
   fi
+  # In the background so that the trap can pass SIGTERM and SIGINT on (a test stopping its child)
+  # and still unmount after; stdin stays the caller's.
   chroot "$root" /usr/bin/env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
     LANG=C.UTF-8 CCACHE_DIR="${CCACHE_DIR:-$checkout/.cache/ccache-trixie}" CCACHE_BASEDIR="$checkout" \
-    CCACHE_NOHASHDIR=true ${CI:+CI=$CI} \
-    sh -c 'cd "$0" && exec "$@"' "$checkout" "$@"
+    CCACHE_NOHASHDIR=true ${CI:+CI=$CI} ${RSG_CHROOT_ENV:-} \
+    sh -c 'cd "$0" 2>/dev/null || cd /; exec "$@"' "$PWD" "$@" <&0 &
+  child=$!
+  trap 'kill -TERM $child 2>/dev/null' TERM
+  trap 'kill -INT $child 2>/dev/null' INT
+  local status=0
+  while :; do
+    wait $child && status=0 || status=$?
+    kill -0 $child 2>/dev/null || break  # wait was interrupted by a trapped signal: wait again
+  done
+  return $status
 }
 
 exec_in_namespace() {
-  unshare --mount --propagation private -- env RSG_TRIXIE_MOUNTED="$root" "$0" __mounted "$@"
+  exec unshare --mount --propagation private -- env RSG_TRIXIE_MOUNTED="$root" "$0" __mounted "$@"
 }
 
 case ${1:-} in

@@ -226,7 +226,7 @@ int run(const Options& options) {
   while (true) {
     fdds::ConditionSeq triggered;
     waitset.wait(triggered,
-                 eprosima::fastrtps::Duration_t(
+                 rsg::dds::Duration(
                      0, static_cast<std::uint32_t>(std::chrono::nanoseconds(kRefreshPeriod).count())));
     matched_writers.update(*reader);
     const auto now = Clock::now();
@@ -236,7 +236,7 @@ int run(const Options& options) {
     }
 
     fdds::RequestedIncompatibleQosStatus incompatible;
-    if (reader->get_requested_incompatible_qos_status(incompatible) == ReturnCode_t::RETCODE_OK &&
+    if (reader->get_requested_incompatible_qos_status(incompatible) == rsg::dds::kOk &&
         incompatible.total_count_change > 0)
       std::cerr << "rsg_echo: a writer of '" << topic_name << "' does not match reader profile '"
                 << qos_profile << "': its " << policy_name(incompatible.last_policy_id)
@@ -244,7 +244,7 @@ int run(const Options& options) {
 
     // Take everything available: at 1 kHz a wake-up finds several samples.
     bool done = false;
-    while (!done && reader->take(samples, infos) == ReturnCode_t::RETCODE_OK) {
+    while (!done && reader->take(samples, infos) == rsg::dds::kOk) {
       for (fdds::LoanableCollection::size_type i = 0; i < samples.length() && !done; ++i) {
         if (!infos[i].valid_data) continue;
         rsg::dds::to_values(samples[i], values);

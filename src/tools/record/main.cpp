@@ -211,7 +211,7 @@ class LossCounter {
   std::uint64_t gaps = 0;
 
  private:
-  std::map<eprosima::fastrtps::rtps::GUID_t, std::uint64_t> last_;
+  std::map<rsg::dds::rtps::GUID_t, std::uint64_t> last_;
 };
 
 void add_options(CLI::App& app, Options& options) {
@@ -281,13 +281,13 @@ int run(const Options& options, rsg::tools::record::Profile profile) {
   fdds::SampleInfo info;
   int exit_code = kExitOk;
   const auto write_what_was_received = [&] {
-    while (readers.state().take_next_sample(&state, &info) == ReturnCode_t::RETCODE_OK) {
+    while (readers.state().take_next_sample(&state, &info) == rsg::dds::kOk) {
       if (!info.valid_data) continue;
       loss.add(info);
       recording.add_state(state, info);
     }
     while (readers.status() != nullptr &&
-           readers.status()->take_next_sample(&status, &info) == ReturnCode_t::RETCODE_OK)
+           readers.status()->take_next_sample(&status, &info) == rsg::dds::kOk)
       if (info.valid_data) recording.add_status(status, info);
     recording.write_batch();
   };

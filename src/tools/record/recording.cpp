@@ -3,11 +3,11 @@
 #include <GatewayStatusPubSubTypes.h>
 #include <RobotStatePubSubTypes.h>
 #include <fastcdr/exceptions/Exception.h>
-#include <fastdds/rtps/common/SerializedPayload.h>
 
 #include <cstring>
 
 #include "recording_schemas.hpp"
+#include "rsg/dds/fastdds_compat.hpp"
 
 namespace rsg::tools::record {
 namespace {
@@ -76,11 +76,11 @@ Channels add_channels(mcap::Writer& writer, Profile profile, const std::string& 
 struct CdrSerializer::Types {
   RobotStatePubSubType robot_state;
   GatewayStatusPubSubType status;
-  eprosima::fastrtps::rtps::SerializedPayload_t payload;
+  rsg::dds::rtps::SerializedPayload_t payload;
 };
 
 CdrSerializer::CdrSerializer() : types_(std::make_unique<Types>()) {
-  types_->payload.reserve(std::max(types_->robot_state.m_typeSize, types_->status.m_typeSize));
+  types_->payload.reserve(std::max(dds::max_serialized_size(types_->robot_state), dds::max_serialized_size(types_->status)));
   std::memset(types_->payload.data, 0, types_->payload.max_size);
 }
 
@@ -97,13 +97,13 @@ CdrSerializer::~CdrSerializer() = default;
 
 std::span<const std::uint8_t> CdrSerializer::serialize(const RobotState& sample) {
   clear_payload();
-  if (!types_->robot_state.serialize(const_cast<RobotState*>(&sample), &types_->payload)) return {};
+  if (!dds::serialize(types_->robot_state, &sample, types_->payload)) return {};
   return {types_->payload.data, types_->payload.length};
 }
 
 std::span<const std::uint8_t> CdrSerializer::serialize(const GatewayStatus& sample) {
   clear_payload();
-  if (!types_->status.serialize(const_cast<GatewayStatus*>(&sample), &types_->payload)) return {};
+  if (!dds::serialize(types_->status, &sample, types_->payload)) return {};
   return {types_->payload.data, types_->payload.length};
 }
 
@@ -115,7 +115,7 @@ bool CdrSerializer::deserialize(std::span<const std::uint8_t> bytes, RobotState&
   payload.length = static_cast<std::uint32_t>(bytes.size());
   payload.pos = 0;
   try {
-    return types_->robot_state.deserialize(&payload, &sample);
+    return dds::deserialize(types_->robot_state, payload, &sample);
   } catch (const eprosima::fastcdr::exception::Exception&) {  // e.g. an unknown encapsulation
     return false;
   }

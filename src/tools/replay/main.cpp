@@ -108,7 +108,7 @@ class DdsOutput final : public Output {
   /// it, and a reader that matched a moment after the writer did never gets them: wait (bounded)
   /// until every matched reader has acknowledged.
   void finish() override {
-    if (writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0)) != ReturnCode_t::RETCODE_OK)
+    if (writer_->wait_for_acknowledgments(rsg::dds::Duration(5, 0)) != rsg::dds::kOk)
       std::cerr << "rsg_replay: not every reader acknowledged the last samples within 5 s\n";
   }
 
@@ -227,7 +227,7 @@ void wait_for_readers(fdds::DataWriter& writer, int readers, const std::atomic<b
   const auto deadline = Clock::now() + std::chrono::seconds(10);
   fdds::PublicationMatchedStatus matched;
   while (!stop && Clock::now() < deadline &&
-         writer.get_publication_matched_status(matched) == ReturnCode_t::RETCODE_OK &&
+         writer.get_publication_matched_status(matched) == rsg::dds::kOk &&
          matched.current_count < readers)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   if (matched.current_count < readers)

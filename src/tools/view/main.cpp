@@ -128,7 +128,7 @@ int run(const Options& options) {
   while (!readers.stop_requested()) {
     readers.wait(kWakeUp);
     matched_writers.update(readers.state());
-    while (readers.state().take_next_sample(&state, &info) == ReturnCode_t::RETCODE_OK) {
+    while (readers.state().take_next_sample(&state, &info) == rsg::dds::kOk) {
       if (!info.valid_data) continue;
       const std::uint64_t time = now_ns();
       const auto cdr = payload_of(serializer.serialize(state));
@@ -139,7 +139,7 @@ int run(const Options& options) {
       summary_pending = true;
     }
     while (readers.status() != nullptr &&
-           readers.status()->take_next_sample(&status, &info) == ReturnCode_t::RETCODE_OK) {
+           readers.status()->take_next_sample(&status, &info) == rsg::dds::kOk) {
       if (!info.valid_data) continue;
       const std::uint64_t time = now_ns();
       const auto cdr = payload_of(serializer.serialize(status));

@@ -8,8 +8,6 @@
 //
 // Every run has its own DDS domain (pid % 200 + 10), ports the kernel picks, and a scratch
 // directory for the children's logs (kept, and named, when the run fails).
-#include <fastrtps/attributes/LibrarySettingsAttributes.h>
-#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <sys/prctl.h>
 #include <unistd.h>
 
@@ -21,6 +19,7 @@
 #include <iostream>
 #include <map>
 
+#include "rsg/dds/fastdds_compat.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "scenarios.hpp"
 
@@ -215,9 +214,7 @@ int main(int argc, char** argv) {
   ::prctl(PR_SET_TIMERSLACK, 1UL);
   // A reader in this process must get its samples over a transport, as one in another process
   // would (embedded_callback reads the embedded gateway's writer from here).
-  eprosima::fastrtps::LibrarySettingsAttributes library;
-  library.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
-  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(library);
+  rsg::dds::disable_intraprocess_delivery();
 
   if (role == "relay") {
     try {

@@ -40,7 +40,7 @@ class CountingReader : private fdds::DataReaderListener {
  private:
   void on_data_available(fdds::DataReader* reader) override {
     fdds::SampleInfo info;
-    while (reader->take_next_sample(&message_, &info) == ReturnCode_t::RETCODE_OK)
+    while (reader->take_next_sample(&message_, &info) == rsg::dds::kOk)
       if (info.valid_data) count_.fetch_add(1);
   }
 

@@ -595,7 +595,7 @@ json run_writer_role(const BenchOptions& options, const Transport& transport) {
     void* loan = nullptr;
     if (writer->loan_sample(loan,
                             fdds::DataWriter::LoanInitializationKind::CONSTRUCTED_LOAN_INITIALIZATION) !=
-        ReturnCode_t::RETCODE_OK)
+        rsg::dds::kOk)
       return false;
     stamped.fill(*static_cast<RobotState*>(loan));
     if (writer->write(loan)) return true;
@@ -608,7 +608,7 @@ json run_writer_role(const BenchOptions& options, const Transport& transport) {
   const SendReport sending =
       send_paced(options.warmup_frames(), options.measured_frames(), options.rate_hz, write);
   const ProcessUsage after = read_usage(::getpid());
-  writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
+  writer->wait_for_acknowledgments(rsg::dds::Duration(5, 0));
   return {{"sent", sending.sent},
           {"send_failed", sending.failed},
           {"seconds", sending.seconds},

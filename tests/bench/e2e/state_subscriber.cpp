@@ -46,7 +46,7 @@ StateSubscriber::StateSubscriber(dds::Participant& participant, const std::strin
       waitset.attach_condition(stop_);
       fdds::ConditionSeq triggered;
       while (!stop_.get_trigger_value()) {
-        waitset.wait(triggered, eprosima::fastrtps::c_TimeInfinite);
+        waitset.wait(triggered, rsg::dds::kInfinite);
         take_all(reader_, monotonic_ns());
       }
     });
@@ -79,7 +79,7 @@ void StateSubscriber::on_data_available(fdds::DataReader* reader) { take_all(rea
 void StateSubscriber::take_all(fdds::DataReader* reader, std::int64_t notified_ns) {
   fdds::LoanableSequence<RobotState> samples;
   fdds::SampleInfoSeq infos;
-  while (reader->take(samples, infos) == ReturnCode_t::RETCODE_OK) {
+  while (reader->take(samples, infos) == rsg::dds::kOk) {
     const std::int64_t received_ns = monotonic_ns();
     for (fdds::LoanableCollection::size_type i = 0; i < samples.length(); ++i)
       if (infos[i].valid_data) {

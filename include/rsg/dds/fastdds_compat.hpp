@@ -1,0 +1,273 @@
+// The one place where Fast DDS 2.x and 3.x differ for rsg (docs/fastdds-versions.md).
+//
+// rsg builds against Fast DDS 2.x (package `fastrtps`: Debian 12's 2.9.1, ROS 2 Jazzy's 2.14) or 3.x
+// (package `fastdds`: Debian 13's 3.1, ROS 2 Kilted's 3.2), whichever CMake finds. The DDS API of
+// `fastdds/dds/` is the same in both; what moved (the `eprosima::fastrtps` namespace, the return
+// codes, `.h` -> `.hpp` RTPS headers, TopicDataType's members, the library settings, discovery
+// servers) is named here once, and the rest of the tree uses these names:
+//
+//   rsg::dds::kOk, Duration, kInfinite   return code and times
+//   rsg::dds::rtps                       the RTPS namespace (GUID_t, Locator_t, IPLocator, ...)
+//   rsg::dds::serialize, deserialize, max_serialized_size, is_plain, rename_type
+//   rsg::dds::succeeded, is_keyed, disable_intraprocess_delivery, profile_defined
+//   rsg::dds::add_discovery_server, discovery_server_locator, discovery_server_prefix
+//
+// fastddsgen 4 names its files .hpp and registers TypeObjects by itself: src/dds/CMakeLists.txt puts
+// forwarding headers with fastddsgen 2's names next to its output (RobotState.h, ...PubSubTypes.h,
+// ...TypeObject.h with an empty registerRobotStateTypes()).
+//
+// Data representation: Fast DDS 3 writes XCDR1 unless told otherwise, which is what Fast DDS 2.x,
+// Cyclone DDS 0.10 and rmw_fastrtps read; rsg states it in the profiles (xml_profiles/rsg.xml) and
+// serializes XCDR1 here, so both builds put the same bytes on the wire.
+#pragma once
+
+#include <cstdint>
+#include <iterator>
+#include <sstream>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/TopicDataType.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <string>
+
+#if __has_include(<fastdds/config.hpp>)
+#include <fastdds/LibrarySettings.hpp>
+#include <fastdds/config.hpp>
+#include <fastdds/dds/core/ReturnCode.hpp>
+#include <fastdds/dds/core/Time_t.hpp>
+#include <fastdds/rtps/attributes/PropertyPolicy.hpp>
+#include <fastdds/rtps/common/SerializedPayload.hpp>
+#include <fastdds/utils/IPLocator.hpp>
+/// The major version of the Fast DDS rsg is built against: 2 or 3.
+#define RSG_FASTDDS_MAJOR FASTDDS_VERSION_MAJOR
+#else
+#include <fastdds/rtps/attributes/PropertyPolicy.h>
+#include <fastdds/rtps/attributes/ServerAttributes.h>
+#include <fastdds/rtps/common/SerializedPayload.h>
+#include <fastrtps/attributes/LibrarySettingsAttributes.h>
+#include <fastrtps/attributes/ParticipantAttributes.h>
+#include <fastrtps/attributes/PublisherAttributes.h>
+#include <fastrtps/attributes/SubscriberAttributes.h>
+#include <fastrtps/config.h>
+#include <fastrtps/types/TypeObjectFactory.h>
+#include <fastrtps/utils/IPLocator.h>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
+#define RSG_FASTDDS_MAJOR FASTRTPS_VERSION_MAJOR
+#endif
+
+namespace rsg::dds {
+
+/// The kinds of XML profile rsg looks up by name.
+enum class ProfileKind { kParticipant, kDataWriter, kDataReader };
+
+#if RSG_FASTDDS_MAJOR >= 3
+
+namespace rtps = eprosima::fastdds::rtps;
+using Duration = eprosima::fastdds::dds::Duration_t;
+using ReturnCode = eprosima::fastdds::dds::ReturnCode_t;
+inline constexpr ReturnCode kOk = eprosima::fastdds::dds::RETCODE_OK;
+inline const Duration kInfinite = eprosima::fastdds::dds::c_TimeInfinite;
+using DiscoveryProtocol = rtps::DiscoveryProtocol;
+
+/// Gives `type` another registered name (the ROS 2 mangled name, a user's --type-name); DDS-SQL
+/// filters on it still find the type's TypeObject (Fast DDS 3 keeps it by type identifier).
+inline void rename_type(eprosima::fastdds::dds::TypeSupport& type, const std::string& name) {
+  type->set_name(name);
+}
+
+/// Fast DDS 3 announces a type's TypeInformation whenever the type has a TypeObject, which content
+/// filters need: there is nothing to turn off.
+inline void announce_no_type_information(eprosima::fastdds::dds::TypeSupport& /*type*/) {}
+
+/// The largest serialized sample, encapsulation included.
+inline std::uint32_t max_serialized_size(const eprosima::fastdds::dds::TopicDataType& type) {
+  return type.max_serialized_type_size;
+}
+
+/// Serializes `sample` as XCDR1 (the representation rsg's writers use) into `payload`.
+inline bool serialize(eprosima::fastdds::dds::TopicDataType& type, const void* sample,
+                      rtps::SerializedPayload_t& payload) {
+  return type.serialize(sample, payload, eprosima::fastdds::dds::XCDR_DATA_REPRESENTATION);
+}
+
+/// Deserializes `payload` (either representation, as its encapsulation says) into `sample`.
+inline bool deserialize(eprosima::fastdds::dds::TopicDataType& type, rtps::SerializedPayload_t& payload,
+                        void* sample) {
+  return type.deserialize(payload, sample);
+}
+
+/// Whether samples of `type` are plain in XCDR1 (loanable, data-sharing).
+inline bool is_plain(const eprosima::fastdds::dds::TopicDataType& type) {
+  return type.is_plain(eprosima::fastdds::dds::XCDR_DATA_REPRESENTATION);
+}
+
+/// Whether a call that returns a ReturnCode_t (Fast DDS 3) or a bool (Fast DDS 2: DataWriter::write)
+/// succeeded.
+inline bool succeeded(ReturnCode code) { return code == kOk; }
+
+/// Whether `type` has a key.
+inline bool is_keyed(const eprosima::fastdds::dds::TopicDataType& type) { return type.is_compute_key_provided; }
+
+/// The locator of discovery server number `index` in `qos`, and the GUID prefix rsg gave it ("" on
+/// Fast DDS 3, which finds servers by locator alone).
+inline rtps::Locator_t discovery_server_locator(const eprosima::fastdds::dds::DomainParticipantQos& qos,
+                                                std::size_t index) {
+  return *(qos.wire_protocol().builtin.discovery_config.m_DiscoveryServers.begin() + index);
+}
+inline std::string discovery_server_prefix(const eprosima::fastdds::dds::DomainParticipantQos& /*qos*/,
+                                           std::size_t /*index*/) {
+  return "";
+}
+
+/// Delivers samples between endpoints of one process through the transports, as between processes.
+inline void disable_intraprocess_delivery() {
+  eprosima::fastdds::LibrarySettings settings;
+  settings.intraprocess_delivery = eprosima::fastdds::INTRAPROCESS_OFF;
+  eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->set_library_settings(settings);
+}
+
+/// Adds the discovery server number `id` at `locator` (Fast DDS 3 needs no server GUID prefix).
+inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& qos, unsigned /*id*/,
+                                 const rtps::Locator_t& locator) {
+  qos.wire_protocol().builtin.discovery_config.m_DiscoveryServers.push_back(locator);
+}
+
+
+/// Whether the loaded XML profiles define a `kind` profile named `name`. Fast DDS 3 keeps its XML
+/// parser private: the writer and reader profiles are looked up through a publisher and a subscriber
+/// of a participant that is never enabled (no socket, no traffic), made and deleted here.
+inline bool profile_defined(ProfileKind kind, const std::string& name) {
+  namespace fdds = eprosima::fastdds::dds;
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  if (kind == ProfileKind::kParticipant) {
+    fdds::DomainParticipantQos qos;
+    return factory->get_participant_qos_from_profile(name, qos) == kOk;
+  }
+  fdds::DomainParticipantFactoryQos factory_qos;
+  factory->get_qos(factory_qos);
+  fdds::DomainParticipantFactoryQos disabled = factory_qos;
+  disabled.entity_factory().autoenable_created_entities = false;
+  factory->set_qos(disabled);
+  fdds::DomainParticipant* participant = factory->create_participant(0, fdds::PARTICIPANT_QOS_DEFAULT);
+  factory->set_qos(factory_qos);
+  if (!participant) return false;
+  bool found = false;
+  if (kind == ProfileKind::kDataWriter) {
+    fdds::DataWriterQos qos;
+    auto* publisher = participant->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+    found = publisher && publisher->get_datawriter_qos_from_profile(name, qos) == kOk;
+  } else {
+    fdds::DataReaderQos qos;
+    auto* subscriber = participant->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+    found = subscriber && subscriber->get_datareader_qos_from_profile(name, qos) == kOk;
+  }
+  participant->delete_contained_entities();
+  factory->delete_participant(participant);
+  return found;
+}
+
+#else  // Fast DDS 2.x
+
+namespace rtps = eprosima::fastrtps::rtps;
+using Duration = eprosima::fastrtps::Duration_t;
+using ReturnCode = eprosima::fastrtps::types::ReturnCode_t;
+inline const ReturnCode kOk = ReturnCode::RETCODE_OK;
+inline const Duration kInfinite = eprosima::fastrtps::c_TimeInfinite;
+using DiscoveryProtocol = rtps::DiscoveryProtocol_t;
+
+/// Fast DDS 2's DDS-SQL filter factory looks the TypeObject up by the topic's type name: registers
+/// the type's objects under `name` too.
+inline void rename_type(eprosima::fastdds::dds::TypeSupport& type, const std::string& name) {
+  auto* factory = eprosima::fastrtps::types::TypeObjectFactory::get_instance();
+  const std::string original = type.get_type_name();
+  for (const bool complete : {true, false})
+    if (const auto* object = factory->get_type_object(original, complete))
+      factory->add_type_object(name, factory->get_type_identifier(original, complete), object);
+  type->setName(name.c_str());
+}
+
+/// Cyclone DDS 0.10 drops the samples of writers that announce TypeInformation: Fast DDS 2 sends
+/// none when told so.
+inline void announce_no_type_information(eprosima::fastdds::dds::TypeSupport& type) {
+  type->auto_fill_type_information(false);
+  type->auto_fill_type_object(false);
+}
+
+inline std::uint32_t max_serialized_size(const eprosima::fastdds::dds::TopicDataType& type) {
+  return type.m_typeSize;
+}
+
+inline bool serialize(eprosima::fastdds::dds::TopicDataType& type, const void* sample,
+                      rtps::SerializedPayload_t& payload) {
+  return type.serialize(const_cast<void*>(sample), &payload);
+}
+
+inline bool deserialize(eprosima::fastdds::dds::TopicDataType& type, rtps::SerializedPayload_t& payload,
+                        void* sample) {
+  return type.deserialize(&payload, sample);
+}
+
+inline bool is_plain(const eprosima::fastdds::dds::TopicDataType& type) { return type.is_plain(); }
+
+inline bool succeeded(ReturnCode code) { return code == kOk; }
+inline bool succeeded(bool done) { return done; }
+
+inline bool is_keyed(const eprosima::fastdds::dds::TopicDataType& type) { return type.m_isGetKeyDefined; }
+
+inline rtps::Locator_t discovery_server_locator(const eprosima::fastdds::dds::DomainParticipantQos& qos,
+                                                std::size_t index) {
+  auto server = qos.wire_protocol().builtin.discovery_config.m_DiscoveryServers.begin();
+  std::advance(server, index);
+  return *server->metatrafficUnicastLocatorList.begin();
+}
+inline std::string discovery_server_prefix(const eprosima::fastdds::dds::DomainParticipantQos& qos,
+                                           std::size_t index) {
+  auto server = qos.wire_protocol().builtin.discovery_config.m_DiscoveryServers.begin();
+  std::advance(server, index);
+  std::ostringstream text;
+  text << server->guidPrefix;
+  return text.str();
+}
+
+inline void disable_intraprocess_delivery() {
+  eprosima::fastrtps::LibrarySettingsAttributes settings;
+  settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
+}
+
+/// Fast DDS 2 finds server number `id` by its default GUID prefix.
+inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& qos, unsigned id,
+                                 const rtps::Locator_t& locator) {
+  eprosima::fastdds::rtps::RemoteServerAttributes remote;
+  eprosima::fastdds::rtps::get_server_client_default_guidPrefix(static_cast<int>(id), remote.guidPrefix);
+  remote.metatrafficUnicastLocatorList.push_back(locator);
+  qos.wire_protocol().builtin.discovery_config.m_DiscoveryServers.push_back(remote);
+}
+
+
+inline bool profile_defined(ProfileKind kind, const std::string& name) {
+  using Profiles = eprosima::fastrtps::xmlparser::XMLProfileManager;
+  constexpr auto kOkXml = eprosima::fastrtps::xmlparser::XMLP_ret::XML_OK;
+  switch (kind) {
+    case ProfileKind::kParticipant: {
+      eprosima::fastrtps::ParticipantAttributes attributes;
+      return Profiles::fillParticipantAttributes(name, attributes, false) == kOkXml;
+    }
+    case ProfileKind::kDataWriter: {
+      eprosima::fastrtps::PublisherAttributes attributes;
+      return Profiles::fillPublisherAttributes(name, attributes, false) == kOkXml;
+    }
+    case ProfileKind::kDataReader: {
+      eprosima::fastrtps::SubscriberAttributes attributes;
+      return Profiles::fillSubscriberAttributes(name, attributes, false) == kOkXml;
+    }
+  }
+  return false;
+}
+
+#endif
+
+}  // namespace rsg::dds

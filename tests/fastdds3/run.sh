@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# make test-fastdds3: rsg against Fast DDS 3 (Debian 13's 3.1.2, Fast CDR 2, fastddsgen 4) in the
+# chroot of tools/fastdds3/chroot.sh, and across versions with the Debian 12 (2.9.1) build of the
+# host. Which tests run where: docs/fastdds-versions.md.
+#
+#   tests/fastdds3/run.sh [HOST_BUILD]     HOST_BUILD: the host's 2.9 build tree (default build)
+#
+# 1. builds the checkout in the chroot into $RSG_FASTDDS3_BUILD (default build-fdds3), the targets
+#    of the chosen tests only;
+# 2. runs there the unit tests (ctest -L unit), the views, the Cyclone interop and the integration
+#    subset below;
+# 3. runs on the host the cross-version tests: the same test scripts with the processes of one side
+#    from the 2.9 build and of the other from the 3.x build (run in the chroot), on one DDS domain,
+#    both ways: the chroot shares the host's network and /dev/shm.
+# Closes with one line "test-fastdds3: N passed, N failed".
+set -uo pipefail
+cd "$(dirname "$0")/../.."
+checkout=$PWD
+host_build=${1:-build}
+build=${RSG_FASTDDS3_BUILD:-build-fdds3}
+jobs=${JOBS:-$(nproc)}
+chroot=tools/fastdds3/chroot.sh
+logs=$build/test-fastdds3
+# The integration tests that also run against 3.x: the pipeline, its errors, selections and late joiners.
+integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors|late_joiner"
+targets=(unit_tests rsg_gateway rsg_sim rsg_echo rsg_frame rsg_status_probe rsg_views_publish
+         rsg_cyclone_echo rsg_cyclone_publish)
+
+passed=0
+failed=0
+count_ctest() {  # ctest's "97% tests passed, 3 tests failed out of 100"
+  local bad total
+  if read -r bad total < <(sed -nE 's/.* tests passed, ([0-9]+) tests? failed out of ([0-9]+).*/\1 \2/p' "$1" | tail -n 1); then
+    passed=$((passed + total - bad)); failed=$((failed + bad))
+  else
+    echo "$1: no ctest summary" >&2; failed=$((failed + 1))
+  fi
+}
+check() {  # NAME COMMAND...: one cross-version test, its output in $logs/NAME.log
+  local name=$1; shift
+  local start=$SECONDS
+  if "$@" > "$logs/$name.log" 2>&1; then
+    passed=$((passed + 1)); echo "cross.$name: passed ($((SECONDS - start)) s)"
+  else
+    failed=$((failed + 1)); echo "cross.$name: FAILED ($((SECONDS - start)) s)"; tail -n 40 "$logs/$name.log"
+  fi
+}
+
+start=$SECONDS
+$chroot setup || exit 1
+$chroot in cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRSG_FASTDDS=3 \
+  -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache > /dev/null || exit 1
+$chroot in cmake --build "$build" -j "$jobs" --target "${targets[@]}" || exit 1
+mkdir -p "$logs"
+echo "test-fastdds3: built in the chroot in $((SECONDS - start)) s"
+
+# 2. In the chroot: Fast DDS 3.1.2 on both ends.
+$chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -L unit" 2>&1 | tee "$logs/unit.log" | tail -n 3
+count_ctest "$logs/unit.log"
+$chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -R '^(views\.rsg_echo|interop\.cyclone|integration\.($integration))\$'" \
+  2>&1 | tee "$logs/processes.log" | grep -E '^ *[0-9]+/[0-9]+ Test|tests passed'
+count_ctest "$logs/processes.log"
+
+# 3. Across versions: Fast DDS 2.9.1 processes on the host, 3.1.2 processes in the chroot.
+if [[ ! -x $host_build/bin/rsg_echo || ! -x $host_build/bin/rsg_views_publish ]]; then
+  echo "test-fastdds3: no host build in $host_build (make build): cross-version tests not run" >&2
+  failed=$((failed + 1))
+else
+  # Bin directories with each tool from one version: a 3.x tool is a script running it in the chroot.
+  mixed() {  # DIR TOOLS_FROM_3X...
+    local dir=$logs/bin-$1; shift
+    rm -rf "$dir"; mkdir -p "$dir"
+    for tool in "$checkout/$host_build"/bin/rsg_*; do ln -s "$tool" "$dir/"; done
+    for tool in "$@"; do
+      rm -f "$dir/$tool"
+      printf '#!/bin/sh\nexec %s in %s "$@"\n' "$checkout/$chroot" "$checkout/$build/bin/$tool" > "$dir/$tool"
+      chmod +x "$dir/$tool"
+    done
+    echo "$dir"
+  }
+  gateway3=$(mixed gateway3 rsg_gateway)
+  echo3=$(mixed echo3 rsg_echo rsg_status_probe)
+  publish3=$(mixed publish3 rsg_views_publish)
+  # Views, content filters included: 3.x readers on a 2.9 writer's stream, and 2.9 readers on 3.x's.
+  check views_2.9_writer_3_readers python3 tests/dds_views/echo_views_test.py --echo "$echo3/rsg_echo" \
+    --publish "$host_build/bin/rsg_views_publish" -v
+  check views_3_writer_2.9_readers python3 tests/dds_views/echo_views_test.py --echo "$host_build/bin/rsg_echo" \
+    --publish "$publish3/rsg_views_publish" -v
+  # The pipeline: a 3.x gateway read by 2.9's rsg_echo, a 2.9 gateway read by 3.x's, values exact.
+  check sim_to_echo_3_gateway_2.9_echo python3 tests/integration/test_sim_to_echo.py --bin "$gateway3"
+  check sim_to_echo_2.9_gateway_3_echo python3 tests/integration/test_sim_to_echo.py --bin "$echo3"
+fi
+echo "test-fastdds3: $((SECONDS - start)) s"
+echo "test-fastdds3: $passed passed, $failed failed"
+[[ $failed == 0 ]]
