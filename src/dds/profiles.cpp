@@ -48,9 +48,8 @@ void load_profiles(const std::filesystem::path& file_or_dir) {
     files.push_back(file_or_dir);
   }
   if (files.empty()) throw InputError(file_or_dir.string() + ": no XML profiles found");
-  auto* factory = eprosima::fastdds::dds::DomainParticipantFactory::get_instance();
   for (const auto& file : files)
-    if (factory->load_XML_profiles_file(file.string()) != kOk)
+    if (load_xml_profiles_file(file.string()) != kOk)
       throw InputError(file.string() +
                        ": Fast DDS rejected this XML profile file (its log above says where)");
 }

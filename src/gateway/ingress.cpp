@@ -46,7 +46,7 @@ class SampleSlot {
 
   /// Writes the sample; a written loan belongs to the writer from then on.
   bool write() {
-    const bool written = writer_.write(sample_);
+    const bool written = dds::succeeded(writer_.write(sample_));
     if (written) loan_ = nullptr;
     return written;
   }

@@ -177,7 +177,7 @@ void Ros2StandardTopics::publish(const Snapshot& snapshot) {
       assign(joint_state.effort(), snapshot.tau_J);
     else
       joint_state.effort().clear();
-    if (joint_states_.writer->write(&joint_state)) joint_states_.written.fetch_add(1);
+    if (dds::succeeded(joint_states_.writer->write(&joint_state))) joint_states_.written.fetch_add(1);
   }
   if (snapshot.outputs & kTf) {
     geometry::TransformStamped_& transform = tf_message.transforms()[0];
@@ -193,14 +193,14 @@ void Ros2StandardTopics::publish(const Snapshot& snapshot) {
     q.y(rotation.y());
     q.z(rotation.z());
     q.w(rotation.w());
-    if (tf_.writer->write(&tf_message)) tf_.written.fetch_add(1);
+    if (dds::succeeded(tf_.writer->write(&tf_message))) tf_.written.fetch_add(1);
   }
   if (snapshot.outputs & kWrench) {
     wrench.header().stamp(stamp);
     const auto& f = snapshot.O_F_ext_hat_K;  // N, N, N, Nm, Nm, Nm
     wrench.wrench().force(vector3(f[0], f[1], f[2]));
     wrench.wrench().torque(vector3(f[3], f[4], f[5]));
-    if (wrench_.writer->write(&wrench)) wrench_.written.fetch_add(1);
+    if (dds::succeeded(wrench_.writer->write(&wrench))) wrench_.written.fetch_add(1);
   }
 }
 

@@ -30,7 +30,7 @@ StatusPublisher::~StatusPublisher() = default;  // the owners delete the writer,
 
 void StatusPublisher::publish(const GatewayStats& stats) {
   to_status_sample(stats, sample_);
-  if (!writer_->write(&sample_)) spdlog::warn("could not write the gateway status");
+  if (!dds::succeeded(writer_->write(&sample_))) spdlog::warn("could not write the gateway status");
 }
 
 }  // namespace rsg::gateway

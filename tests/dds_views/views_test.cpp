@@ -163,7 +163,7 @@ TEST_F(Views, ViewReadersReceiveExactlyTheSamplesCarryingAllTheirGroups) {
   RobotState sample;
   for (const wire::StateValues& values : stream) {
     dds::to_sample(values, sample);
-    ASSERT_TRUE(writer->write(&sample));
+    ASSERT_TRUE(dds::succeeded(writer->write(&sample)));
   }
   ASSERT_EQ(writer->wait_for_acknowledgments(rsg::dds::Duration(60, 0)),
             rsg::dds::kOk);

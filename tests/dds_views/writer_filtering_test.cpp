@@ -88,7 +88,7 @@ Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qo
   RobotState sample;
   for (std::size_t i = 0; i < stream.size(); ++i) {
     dds::to_sample(stream[i], sample);
-    EXPECT_TRUE(writer->write(&sample));
+    EXPECT_TRUE(dds::succeeded(writer->write(&sample)));
     if (stream[i].selection.covers_groups(kForces)) outcome.accepted.insert(static_cast<std::int64_t>(i + 1));
   }
   outcome.written = stream.size();

@@ -55,7 +55,10 @@ mkdir -p "$logs"
 echo "test-fastdds3: built in the chroot in $((SECONDS - start)) s"
 
 # 2. In the chroot: Fast DDS 3.1.2 on both ends.
-$chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -L unit" 2>&1 | tee "$logs/unit.log" | tail -n 3
+# Not here: IngressAllocation.* (Fast DDS 3.1.2 allocates inside DataWriter::write(), the zero-allocation
+# claim is 2.9's: docs/fastdds-versions.md) and packaging (installs the whole tree; only the targets
+# above are built).
+$chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -L unit -E '^(IngressAllocation\..*|packaging)\$'" 2>&1 | tee "$logs/unit.log" | tail -n 3
 count_ctest "$logs/unit.log"
 $chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -R '^(views\.rsg_echo|interop\.cyclone|integration\.($integration))\$'" \
   2>&1 | tee "$logs/processes.log" | grep -E '^ *[0-9]+/[0-9]+ Test|tests passed'

@@ -10,6 +10,7 @@
 //   rsg::dds::rtps                       the RTPS namespace (GUID_t, Locator_t, IPLocator, ...)
 //   rsg::dds::serialize, deserialize, max_serialized_size, is_plain, rename_type
 //   rsg::dds::succeeded, is_keyed, disable_intraprocess_delivery, profile_defined
+//   rsg::dds::load_xml_profiles_file
 //   rsg::dds::add_discovery_server, discovery_server_locator, discovery_server_prefix
 //
 // fastddsgen 4 names its files .hpp and registers TypeObjects by itself: src/dds/CMakeLists.txt puts
@@ -21,7 +22,10 @@
 // serializes XCDR1 here, so both builds put the same bytes on the wire.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <fstream>
+#include <regex>
 #include <iterator>
 #include <sstream>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -32,6 +36,7 @@
 #include <fastdds/dds/topic/TopicDataType.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <string>
+#include <utility>
 
 #if __has_include(<fastdds/config.hpp>)
 #include <fastdds/LibrarySettings.hpp>
@@ -76,6 +81,40 @@ using DiscoveryProtocol = rtps::DiscoveryProtocol;
 /// filters on it still find the type's TypeObject (Fast DDS 3 keeps it by type identifier).
 inline void rename_type(eprosima::fastdds::dds::TypeSupport& type, const std::string& name) {
   type->set_name(name);
+}
+
+/// Loads an XML profile file written for Fast DDS 2 (rsg's xml_profiles/) or 3. Fast DDS 3 renamed
+/// the elements of a writer's and a reader's <times> to snake case and lists discovery servers as
+/// bare locators, and rejects the old forms, which Fast DDS 2 needs: they are rewritten here before
+/// Fast DDS 3 parses the file.
+inline ReturnCode load_xml_profiles_file(const std::string& path) {
+  static constexpr std::array<std::pair<const char*, const char*>, 6> kRenamed{{
+      {"initialHeartbeatDelay", "initial_heartbeat_delay"},
+      {"heartbeatPeriod", "heartbeat_period"},
+      {"nackResponseDelay", "nack_response_delay"},
+      {"nackSupressionDuration", "nack_supression_duration"},
+      {"heartbeatResponseDelay", "heartbeat_response_delay"},
+      {"initialAcknackDelay", "initial_acknack_delay"},
+  }};
+  std::ifstream in(path);
+  if (!in) return eprosima::fastdds::dds::RETCODE_ERROR;
+  std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const auto& [from, to] : kRenamed)
+    for (const std::string prefix : {"<", "</"})
+      for (std::size_t at = 0; (at = xml.find(prefix + from + ">", at)) != std::string::npos;)
+        xml.replace(at, prefix.size() + std::char_traits<char>::length(from), prefix + to);
+  // A discovery server is a <RemoteServer prefix=...> with a <metatrafficUnicastLocatorList> in
+  // Fast DDS 2, its bare <locator> in Fast DDS 3 (which needs no prefix).
+  static const std::regex kServerWrapper(R"(</?RemoteServer\b[^>]*>|</?metatrafficUnicastLocatorList>)");
+  for (std::size_t begin = 0; (begin = xml.find("<discoveryServersList>", begin)) != std::string::npos;) {
+    const std::size_t end = xml.find("</discoveryServersList>", begin);
+    if (end == std::string::npos) break;
+    const std::string list = std::regex_replace(xml.substr(begin, end - begin), kServerWrapper, "");
+    xml.replace(begin, end - begin, list);
+    begin += list.size();
+  }
+  return eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->load_XML_profiles_string(xml.data(),
+                                                                                                    xml.size());
 }
 
 /// Fast DDS 3 announces a type's TypeInformation whenever the type has a TypeObject, which content
@@ -211,6 +250,10 @@ inline bool deserialize(eprosima::fastdds::dds::TopicDataType& type, rtps::Seria
 }
 
 inline bool is_plain(const eprosima::fastdds::dds::TopicDataType& type) { return type.is_plain(); }
+
+inline ReturnCode load_xml_profiles_file(const std::string& path) {
+  return eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->load_XML_profiles_file(path);
+}
 
 inline bool succeeded(ReturnCode code) { return code == kOk; }
 inline bool succeeded(bool done) { return done; }

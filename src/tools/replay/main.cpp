@@ -99,7 +99,7 @@ class DdsOutput final : public Output {
       throw rsg::EnvironmentError("cannot create a writer with profile '" + options.writer_profile + "'");
   }
   bool send(const rsg::RobotState& sample) override {
-    if (writer_->write(const_cast<rsg::RobotState*>(&sample))) return true;
+    if (rsg::dds::succeeded(writer_->write(const_cast<rsg::RobotState*>(&sample)))) return true;
     std::cerr << "rsg_replay: the DDS writer refused a sample\n";
     return false;
   }

@@ -598,7 +598,7 @@ json run_writer_role(const BenchOptions& options, const Transport& transport) {
         rsg::dds::kOk)
       return false;
     stamped.fill(*static_cast<RobotState*>(loan));
-    if (writer->write(loan)) return true;
+    if (rsg::dds::succeeded(writer->write(loan))) return true;
     writer->discard_loan(loan);
     return false;
   };
