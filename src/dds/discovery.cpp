@@ -50,8 +50,7 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
     builtin.discovery_config.discoveryProtocol = rsg::dds::DiscoveryProtocol::CLIENT;
     // Fast DDS's 450 ms cycle made a gateway's first sample reach a reader ~1.1 s after start; at
     // 50 ms (with xml_profiles/discovery_server/ on the server) it is ~0.4 s, same traffic once matched.
-    builtin.discovery_config.discoveryServer_client_syncperiod =
-        rsg::dds::Duration(0, 50'000'000);
+    builtin.discovery_config.discoveryServer_client_syncperiod = rsg::dds::Duration(0, 50'000'000);
   }
 
   if (!options.empty()) {

@@ -51,8 +51,7 @@ inline eprosima::fastdds::dds::DataWriter* create_writer_with_profile(
     const std::string& profile) {
   eprosima::fastdds::dds::DataWriterQos qos;
   if (ros2_type_hash(topic->get_type_name()).empty() ||
-      publisher.get_datawriter_qos_from_profile(profile, qos) !=
-          rsg::dds::kOk)
+      publisher.get_datawriter_qos_from_profile(profile, qos) != rsg::dds::kOk)
     return publisher.create_datawriter_with_profile(topic, profile);
   announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
   return publisher.create_datawriter(topic, qos);
@@ -64,8 +63,7 @@ inline eprosima::fastdds::dds::DataReader* create_reader_with_profile(
     const std::string& profile) {
   eprosima::fastdds::dds::DataReaderQos qos;
   if (ros2_type_hash(topic->get_type_name()).empty() ||
-      subscriber.get_datareader_qos_from_profile(profile, qos) !=
-          rsg::dds::kOk)
+      subscriber.get_datareader_qos_from_profile(profile, qos) != rsg::dds::kOk)
     return subscriber.create_datareader_with_profile(topic, profile);
   announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
   return subscriber.create_datareader(topic, qos);

@@ -76,9 +76,8 @@ class MonitorReaders {
   /// Until data arrives on either reader, a stop is requested, or `timeout` passes.
   void wait(std::chrono::nanoseconds timeout) {
     eprosima::fastdds::dds::ConditionSeq triggered;
-    waitset_.wait(triggered, rsg::dds::Duration(
-                                 static_cast<std::int32_t>(timeout.count() / 1'000'000'000),
-                                 static_cast<std::uint32_t>(timeout.count() % 1'000'000'000)));
+    waitset_.wait(triggered, rsg::dds::Duration(static_cast<std::int32_t>(timeout.count() / 1'000'000'000),
+                                                static_cast<std::uint32_t>(timeout.count() % 1'000'000'000)));
   }
 
  private:

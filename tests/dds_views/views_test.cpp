@@ -165,8 +165,7 @@ TEST_F(Views, ViewReadersReceiveExactlyTheSamplesCarryingAllTheirGroups) {
     dds::to_sample(values, sample);
     ASSERT_TRUE(dds::succeeded(writer->write(&sample)));
   }
-  ASSERT_EQ(writer->wait_for_acknowledgments(rsg::dds::Duration(60, 0)),
-            rsg::dds::kOk);
+  ASSERT_EQ(writer->wait_for_acknowledgments(rsg::dds::Duration(60, 0)), rsg::dds::kOk);
 
   for (Case& test_case : cases) {
     SCOPED_TRACE(test_case.reader->view().name);

@@ -101,8 +101,7 @@ Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qo
     while (reader->take_next_sample(&sample, &info) == rsg::dds::kOk)
       outcome.received.insert(info.sample_identity.sequence_number().to64long());
   }
-  EXPECT_EQ(writer->wait_for_acknowledgments(rsg::dds::Duration(60, 0)),
-            rsg::dds::kOk);
+  EXPECT_EQ(writer->wait_for_acknowledgments(rsg::dds::Duration(60, 0)), rsg::dds::kOk);
   while (reader->take_next_sample(&sample, &info) == rsg::dds::kOk)  // nothing more may come
     outcome.received.insert(info.sample_identity.sequence_number().to64long());
   outcome.sent = sent->sequence_numbers();
@@ -140,8 +139,7 @@ TEST(WriterSideFiltering, TheGatewayWriterProfileKeepsRejectedSamplesOffTheWire)
   dds::load_profiles(dds::default_profiles_dir());
   dds::Participant any(static_cast<int>(::getpid() % 200 + 10), "");
   fdds::DataWriterQos gateway_qos;
-  ASSERT_EQ(any.publisher()->get_datawriter_qos_from_profile("rsg_state_writer", gateway_qos),
-            rsg::dds::kOk);
+  ASSERT_EQ(any.publisher()->get_datawriter_qos_from_profile("rsg_state_writer", gateway_qos), rsg::dds::kOk);
   const Outcome outcome = publish_mixed_stream_to_a_view(gateway_qos, Delivery::kUdp);
   ASSERT_LT(outcome.accepted.size(), outcome.written);
   EXPECT_EQ(outcome.sent, outcome.accepted) << "the gateway's writer put rejected samples on the wire";

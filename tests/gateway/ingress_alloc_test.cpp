@@ -195,8 +195,7 @@ class IngressAllocation : public ::testing::Test {
 
     RobotState sample;
     fdds::SampleInfo info;
-    EXPECT_EQ(reader->take_next_sample(&sample, &info), rsg::dds::kOk)
-        << "nothing reached the reader";
+    EXPECT_EQ(reader->take_next_sample(&sample, &info), rsg::dds::kOk) << "nothing reached the reader";
     subscribing_.subscriber()->delete_datareader(reader);
     if (check_after) check_after(ingress, sent);
     return final_stats;

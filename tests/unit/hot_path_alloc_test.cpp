@@ -122,8 +122,7 @@ void expect_no_allocations_while_publishing(const std::string& profile, bool rea
   // now and then finds no valid sample in Fast DDS 2.9.1 (about 1 run in 4 here; views tests saw
   // the same), so it is not asserted there.
   if (reader_data_sharing) return;
-  EXPECT_TRUE(reader->wait_for_unread_message(rsg::dds::Duration(10, 0)))
-      << "nothing reached the reader";
+  EXPECT_TRUE(reader->wait_for_unread_message(rsg::dds::Duration(10, 0))) << "nothing reached the reader";
   RobotState received;
   fdds::SampleInfo info;
   EXPECT_EQ(reader->take_next_sample(&received, &info), rsg::dds::kOk);

@@ -24,10 +24,6 @@
 
 #include <array>
 #include <cstdint>
-#include <fstream>
-#include <regex>
-#include <iterator>
-#include <sstream>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
@@ -35,6 +31,10 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TopicDataType.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fstream>
+#include <iterator>
+#include <regex>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -113,8 +113,8 @@ inline ReturnCode load_xml_profiles_file(const std::string& path) {
     xml.replace(begin, end - begin, list);
     begin += list.size();
   }
-  return eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->load_XML_profiles_string(xml.data(),
-                                                                                                    xml.size());
+  return eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->load_XML_profiles_string(
+      xml.data(), xml.size());
 }
 
 /// Fast DDS 3 announces a type's TypeInformation whenever the type has a TypeObject, which content
@@ -148,7 +148,9 @@ inline bool is_plain(const eprosima::fastdds::dds::TopicDataType& type) {
 inline bool succeeded(ReturnCode code) { return code == kOk; }
 
 /// Whether `type` has a key.
-inline bool is_keyed(const eprosima::fastdds::dds::TopicDataType& type) { return type.is_compute_key_provided; }
+inline bool is_keyed(const eprosima::fastdds::dds::TopicDataType& type) {
+  return type.is_compute_key_provided;
+}
 
 /// The locator of discovery server number `index` in `qos`, and the GUID prefix rsg gave it ("" on
 /// Fast DDS 3, which finds servers by locator alone).
@@ -173,7 +175,6 @@ inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& q
                                  const rtps::Locator_t& locator) {
   qos.wire_protocol().builtin.discovery_config.m_DiscoveryServers.push_back(locator);
 }
-
 
 /// Whether the loaded XML profiles define a `kind` profile named `name`. Fast DDS 3 keeps its XML
 /// parser private: the writer and reader profiles are looked up through a publisher and a subscriber
@@ -289,7 +290,6 @@ inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& q
   remote.metatrafficUnicastLocatorList.push_back(locator);
   qos.wire_protocol().builtin.discovery_config.m_DiscoveryServers.push_back(remote);
 }
-
 
 inline bool profile_defined(ProfileKind kind, const std::string& name) {
   using Profiles = eprosima::fastrtps::xmlparser::XMLProfileManager;

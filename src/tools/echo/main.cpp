@@ -225,9 +225,9 @@ int run(const Options& options) {
 
   while (true) {
     fdds::ConditionSeq triggered;
-    waitset.wait(triggered,
-                 rsg::dds::Duration(
-                     0, static_cast<std::uint32_t>(std::chrono::nanoseconds(kRefreshPeriod).count())));
+    waitset.wait(
+        triggered,
+        rsg::dds::Duration(0, static_cast<std::uint32_t>(std::chrono::nanoseconds(kRefreshPeriod).count())));
     matched_writers.update(*reader);
     const auto now = Clock::now();
     if (stop.get_trigger_value()) {

@@ -286,8 +286,7 @@ int run(const Options& options, rsg::tools::record::Profile profile) {
       loss.add(info);
       recording.add_state(state, info);
     }
-    while (readers.status() != nullptr &&
-           readers.status()->take_next_sample(&status, &info) == rsg::dds::kOk)
+    while (readers.status() != nullptr && readers.status()->take_next_sample(&status, &info) == rsg::dds::kOk)
       if (info.valid_data) recording.add_status(status, info);
     recording.write_batch();
   };

@@ -80,7 +80,8 @@ struct CdrSerializer::Types {
 };
 
 CdrSerializer::CdrSerializer() : types_(std::make_unique<Types>()) {
-  types_->payload.reserve(std::max(dds::max_serialized_size(types_->robot_state), dds::max_serialized_size(types_->status)));
+  types_->payload.reserve(
+      std::max(dds::max_serialized_size(types_->robot_state), dds::max_serialized_size(types_->status)));
   std::memset(types_->payload.data, 0, types_->payload.max_size);
 }
 

@@ -227,8 +227,7 @@ void wait_for_readers(fdds::DataWriter& writer, int readers, const std::atomic<b
   const auto deadline = Clock::now() + std::chrono::seconds(10);
   fdds::PublicationMatchedStatus matched;
   while (!stop && Clock::now() < deadline &&
-         writer.get_publication_matched_status(matched) == rsg::dds::kOk &&
-         matched.current_count < readers)
+         writer.get_publication_matched_status(matched) == rsg::dds::kOk && matched.current_count < readers)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   if (matched.current_count < readers)
     std::cerr << "rsg_replay: only " << matched.current_count << " of " << readers

@@ -593,9 +593,8 @@ json run_writer_role(const BenchOptions& options, const Transport& transport) {
   const auto write = [&](std::uint64_t k) {
     stamped.stamp_now(k);
     void* loan = nullptr;
-    if (writer->loan_sample(loan,
-                            fdds::DataWriter::LoanInitializationKind::CONSTRUCTED_LOAN_INITIALIZATION) !=
-        rsg::dds::kOk)
+    if (writer->loan_sample(
+            loan, fdds::DataWriter::LoanInitializationKind::CONSTRUCTED_LOAN_INITIALIZATION) != rsg::dds::kOk)
       return false;
     stamped.fill(*static_cast<RobotState*>(loan));
     if (rsg::dds::succeeded(writer->write(loan))) return true;
