@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
   rsg::RobotState sample;
   for (const rsg::wire::StateValues& values : rsg::test::mixed_stream(count)) {
     rsg::dds::to_sample(values, sample);
-    if (!writer->write(&sample)) {
+    if (!rsg::dds::succeeded(writer->write(&sample))) {
       std::cerr << "rsg_views_publish: write failed\n";
       return 1;
     }
