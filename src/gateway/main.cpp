@@ -9,7 +9,6 @@
 
 #include <CLI/CLI.hpp>
 #include <atomic>
-#include <csignal>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -17,6 +16,7 @@
 #include "config.hpp"
 #include "gateway.hpp"
 #include "rsg/error.hpp"
+#include "stop_on_signal.hpp"
 #include "tool_main.hpp"
 
 namespace {
@@ -24,6 +24,7 @@ namespace {
 using rsg::gateway::GatewayConfig;
 using rsg::tools::kExitOk;
 using rsg::tools::kExitUsage;
+using rsg::tools::StopOnSignal;
 
 constexpr const char* kRealtimeHelp = R"(Real-time mode applies to the ingress thread (the main thread):
   --rt-priority N  SCHED_FIFO at N needs CAP_SYS_NICE or `USER - rtprio N` in
@@ -32,26 +33,6 @@ constexpr const char* kRealtimeHelp = R"(Real-time mode applies to the ingress t
                    --ulimit rtprio=99 --ulimit memlock=-1
   --cpu CPU        needs only a CPU of the process's cpuset (taskset, docker --cpuset-cpus).
 Whatever is refused is logged as one warning and the gateway runs without it.)";
-
-std::atomic<bool> stop_requested{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
-
-void request_stop(int) { stop_requested.store(true); }
-
-// SIGUSR1: write the flight recorder's pcap file (the loop does it; a handler may not).
-std::atomic<bool> dump_requested{false};
-void request_dump(int) { dump_requested.store(true); }
-
-void install_stop_handlers() {
-  struct sigaction action {};
-  action.sa_handler = request_stop;
-  sigemptyset(&action.sa_mask);
-  action.sa_flags = 0;  // no SA_RESTART: a blocking receive returns at once with EINTR
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
-  action.sa_handler = request_dump;
-  sigaction(SIGUSR1, &action, nullptr);
-}
 
 // Every config key becomes a long flag bound to `config`; CLI11 writes only the flags that are
 // given, so binding them to a configuration read from the file makes flags override the file.
@@ -130,6 +111,7 @@ std::optional<int> parse_command_line(int argc, char** argv, GatewayConfig& conf
 }  // namespace
 
 int main(int argc, char** argv) {
+  StopOnSignal::block_stop_signals(/*with_dump=*/true);
   GatewayConfig config;
   if (const auto exit_status = parse_command_line(argc, argv, config)) return *exit_status;
 
@@ -138,10 +120,13 @@ int main(int argc, char** argv) {
 
   return rsg::tools::run_reporting_errors("rsg_gateway", [&] {
     const rsg::gateway::GatewaySetup setup = rsg::gateway::prepare(config);
-    install_stop_handlers();
+    // SIGUSR1 writes the flight recorder's pcap file: the loop does it when it sees `dump`.
+    std::atomic<bool> stop{false};
+    std::atomic<bool> dump{false};
+    const StopOnSignal signals([&stop] { stop = true; }, [&dump] { dump = true; });
     rsg::gateway::Gateway gateway(setup);
     rsg::gateway::enter_realtime_mode(config);
-    gateway.run(stop_requested, &dump_requested);
+    gateway.run(stop, &dump);
     return kExitOk;
   });
 }

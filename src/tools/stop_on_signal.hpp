@@ -1,7 +1,7 @@
-// SIGINT and SIGTERM as a stop request for the command-line tools (rsg_echo, rsg_record,
-// rsg_replay). The signals are blocked in every thread (block_stop_signals() runs before DDS starts
-// its threads) and taken synchronously by one thread of this object, so no async-signal-unsafe code
-// ever runs in a signal handler.
+// SIGINT and SIGTERM as a stop request (and SIGUSR1 as rsg_gateway's dump request) for every rsg
+// executable. The signals are blocked in every thread (block_stop_signals() runs before DDS starts
+// its threads) and taken synchronously by one thread of this object: no handler, no global flag, and
+// no async-signal-unsafe code in a signal handler.
 #pragma once
 
 #include <pthread.h>
@@ -15,29 +15,37 @@ namespace rsg::tools {
 
 class StopOnSignal {
  public:
-  static void block_stop_signals() {
-    const sigset_t signals = stop_signals();
+  /// Blocks SIGINT and SIGTERM, and SIGUSR1 `with_dump`, in the calling thread and in every thread
+  /// it starts from then on. Call it first in main, before DDS starts its threads.
+  static void block_stop_signals(bool with_dump = false) {
+    const sigset_t signals = taken_signals(with_dump);
     pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   }
 
-  /// Calls `on_stop` once, from this object's thread, when SIGINT or SIGTERM arrives.
-  explicit StopOnSignal(std::function<void()> on_stop)
-      : thread_([on_stop = std::move(on_stop)](std::stop_token token) {
-          const sigset_t signals = stop_signals();
+  /// Calls `on_stop` once, from this object's thread, when SIGINT or SIGTERM arrives; and `on_dump`
+  /// (when given: block_stop_signals(true) first) on every SIGUSR1 until then.
+  explicit StopOnSignal(std::function<void()> on_stop, std::function<void()> on_dump = {})
+      : thread_([on_stop = std::move(on_stop), on_dump = std::move(on_dump)](std::stop_token token) {
+          const sigset_t signals = taken_signals(static_cast<bool>(on_dump));
           const timespec poll{0, 100'000'000};  // to notice the stop request
-          while (!token.stop_requested())
-            if (sigtimedwait(&signals, nullptr, &poll) > 0) {
+          while (!token.stop_requested()) {
+            const int signal = sigtimedwait(&signals, nullptr, &poll);
+            if (signal == SIGUSR1) {
+              on_dump();
+            } else if (signal > 0) {
               on_stop();
               return;
             }
+          }
         }) {}
 
  private:
-  static sigset_t stop_signals() {
+  static sigset_t taken_signals(bool with_dump) {
     sigset_t signals;
     sigemptyset(&signals);
     sigaddset(&signals, SIGINT);
     sigaddset(&signals, SIGTERM);
+    if (with_dump) sigaddset(&signals, SIGUSR1);
     return signals;
   }
 

@@ -2,7 +2,6 @@
 // faults a gateway must survive. See `rsg_sim --help`; the logic lives in rsg_sim_core.
 #include <CLI/CLI.hpp>
 #include <atomic>
-#include <csignal>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -13,6 +12,7 @@
 #include "replay.hpp"
 #include "rsg/error.hpp"
 #include "simulator.hpp"
+#include "stop_on_signal.hpp"
 #include "tool_main.hpp"
 #include "udp_stream.hpp"
 
@@ -21,19 +21,6 @@ namespace {
 using rsg::tools::kExitFailure;
 using rsg::tools::kExitOk;
 using rsg::tools::kExitUsage;
-
-// Set from the signal handler: the only state shared with it.
-std::atomic<bool> g_stop{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
-
-void request_stop(int) { g_stop.store(true, std::memory_order_relaxed); }
-
-void install_stop_handlers() {
-  struct sigaction action {};
-  action.sa_handler = request_stop;
-  sigemptyset(&action.sa_mask);
-  for (const int signal : {SIGINT, SIGTERM}) sigaction(signal, &action, nullptr);
-}
 
 struct Options {
   std::string to;
@@ -183,9 +170,10 @@ void add_options(CLI::App& app, Options& options, rsg::tools::sim::SimConfig& co
 int run_replay(const Options& options) {
   const rsg::transport::Endpoint peer = rsg::transport::Endpoint::parse(options.to);
   rsg::transport::UdpSocket socket = rsg::transport::UdpSocket::for_sending_to(peer);
-  install_stop_handlers();
+  std::atomic<bool> stop{false};
+  const rsg::tools::StopOnSignal signals([&stop] { stop = true; });
   const rsg::tools::sim::ReplayReport report =
-      rsg::tools::sim::replay(options.replay_path, socket, peer, options.replay, g_stop, std::cerr);
+      rsg::tools::sim::replay(options.replay_path, socket, peer, options.replay, stop, std::cerr);
   std::cerr << "rsg_sim: replayed " << report.sent << " datagrams to port " << report.port << " ("
             << report.passes << " complete passes, " << report.send_failures << " send failures)\n";
   return report.send_failures == 0 ? kExitOk : kExitFailure;
@@ -212,6 +200,7 @@ void check_probabilities(const rsg::tools::sim::FaultConfig& faults) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  rsg::tools::StopOnSignal::block_stop_signals();
   CLI::App app{"Simulated Franka Panda: streams SEND_BUF frames (docs/protocol.md) over UDP.", "rsg_sim"};
   app.footer(std::string(kScheduleHelp) +
              "\n\nRuns until --count/--duration or SIGINT/SIGTERM. Exit status: 0 success, 1 runtime "
@@ -251,9 +240,10 @@ int main(int argc, char** argv) {
       limits.duration = std::chrono::duration_cast<std::chrono::nanoseconds>(
           std::chrono::duration<double>(*options.duration_s));
 
-    install_stop_handlers();
+    std::atomic<bool> stop{false};
+    const rsg::tools::StopOnSignal signals([&stop] { stop = true; });
     std::cerr << "rsg_sim: sending to " << peer.to_string() << " at " << config.rate_hz << " Hz\n";
-    rsg::tools::sim::stream(sim, link, limits, g_stop, std::cerr);
+    rsg::tools::sim::stream(sim, link, limits, stop, std::cerr);
 
     std::cerr << "rsg_sim: " << sim.report().summary() << "\n";
     if (!options.report_path.empty()) {
