@@ -16,6 +16,7 @@
 #include "rsg/wire/field_docs.hpp"
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/frame.hpp"
+#include "tool_main.hpp"
 
 namespace {
 
@@ -85,25 +86,19 @@ std::string tables() {
 int main(int argc, char** argv) {
   if (argc != 3) {
     std::cerr << "usage: rsg_wireshark_lua TEMPLATE OUTPUT\n";
-    return 2;
+    return rsg::tools::kExitUsage;
   }
-  std::ifstream in(argv[1], std::ios::binary);
-  if (!in) {
-    std::cerr << "error: cannot read '" << argv[1] << "'\n";
-    return 1;
-  }
-  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  const std::size_t at = text.find(kPlaceholder);
-  if (at == std::string::npos) {
-    std::cerr << "error: '" << argv[1] << "' has no " << kPlaceholder << '\n';
-    return 1;
-  }
-  text.replace(at, kPlaceholder.size(), tables());
-  std::ofstream out(argv[2], std::ios::binary | std::ios::trunc);
-  out << text;
-  if (!out.flush()) {
-    std::cerr << "error: cannot write '" << argv[2] << "'\n";
-    return 1;
-  }
-  return 0;
+  return rsg::tools::run_reporting_errors("rsg_wireshark_lua", [&] {
+    std::ifstream in(argv[1], std::ios::binary);
+    if (!in) throw rsg::InputError(std::string("cannot read '") + argv[1] + "'");
+    std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::size_t at = text.find(kPlaceholder);
+    if (at == std::string::npos)
+      throw rsg::InputError(std::string("'") + argv[1] + "' has no " + std::string(kPlaceholder));
+    text.replace(at, kPlaceholder.size(), tables());
+    std::ofstream out(argv[2], std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out.flush()) throw rsg::EnvironmentError(std::string("cannot write '") + argv[2] + "'");
+    return rsg::tools::kExitOk;
+  });
 }
