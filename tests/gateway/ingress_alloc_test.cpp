@@ -3,7 +3,7 @@
 // frames after 1,000 of warm-up, counting every operator new made on this thread. The ingress
 // has an `on_sample` callback, as rsg::gateway::EmbeddedGateway gives it, so the embedded path from
 // datagram to callback is counted too.
-// tests/unit/hot_path_alloc_test.cpp covers decode + write alone.
+// tests/dds/hot_path_alloc_test.cpp covers decode + write alone.
 //
 // Fast DDS 2.9.1's reliable writer (StatefulWriter, which the RELIABLE rsg_state_writer profile
 // gets) allocates on every write: it hands per-reader lambdas to for_matched_readers() as a
