@@ -99,20 +99,24 @@ class UdpSocket {
   UdpSocket& operator=(const UdpSocket&) = delete;
   ~UdpSocket();
 
-  /// Waits up to `timeout` for one datagram. Returns its full size (which may exceed
-  /// `buffer.size()`: the datagram was truncated) or nothing on timeout or EINTR.
+  /// Waits up to `timeout` for one datagram. The per-frame path: never throws.
+  /// @return its full size (which may exceed `buffer.size()`: the datagram was truncated), or
+  /// nothing on timeout or EINTR.
   std::optional<std::size_t> receive(std::span<std::uint8_t> buffer, Endpoint* from,
                                      std::chrono::milliseconds timeout);
-  /// Waits up to `timeout` for a datagram to be queued; false on timeout or EINTR.
+  /// Waits up to `timeout` for a datagram to be queued.
+  /// @return false on timeout or EINTR.
   bool wait_readable(std::chrono::milliseconds timeout);
   /// Takes the datagrams already queued, at most `batch.capacity()`, in one system call (recvmmsg)
-  /// and without waiting. Returns how many `batch` now holds: 0 when none was queued.
+  /// and without waiting.
+  /// @return how many `batch` now holds: 0 when none was queued.
   std::size_t receive_batch(DatagramBatch& batch);
-  /// Sends one datagram; false (errno kept) when the kernel refused it.
+  /// Sends one datagram.
+  /// @return false (errno kept) when the kernel refused it.
   bool send_to(std::span<const std::uint8_t> datagram, const Endpoint& to);
 
-  /// Asks for a larger kernel receive buffer so bursts at 1 kHz+ are not dropped; returns what
-  /// the kernel granted.
+  /// Asks for a larger kernel receive buffer so bursts at 1 kHz+ are not dropped.
+  /// @return the size the kernel granted.
   int set_receive_buffer(int bytes);
   Endpoint local_endpoint() const;
   int fd() const { return fd_; }
