@@ -23,7 +23,7 @@ chroot=tools/fastdds3/chroot.sh
 logs=$build/test-fastdds3
 # The integration tests that also run against 3.x: the pipeline, its errors, selections and late joiners.
 integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors|late_joiner"
-targets=(unit_tests rsg_gateway rsg_sim rsg_echo rsg_frame rsg_status_probe rsg_views_publish
+targets=(unit_tests rsg_gateway rsg_sim rsg_echo rsg_frame rsg_status_probe rsg_views_publish rsg_view
          rsg_cyclone_echo rsg_cyclone_publish)
 
 passed=0

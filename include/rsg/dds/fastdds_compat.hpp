@@ -35,6 +35,7 @@
 #include <iterator>
 #include <regex>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -164,10 +165,16 @@ inline std::string discovery_server_prefix(const eprosima::fastdds::dds::DomainP
 }
 
 /// Delivers samples between endpoints of one process through the transports, as between processes.
+/// Fast DDS 3 refuses the change once a participant is enabled (Fast DDS 2 applied it to the
+/// participants created after it): call it before the first participant.
 inline void disable_intraprocess_delivery() {
+  auto* factory = eprosima::fastdds::dds::DomainParticipantFactory::get_instance();
   eprosima::fastdds::LibrarySettings settings;
+  factory->get_library_settings(settings);
+  if (settings.intraprocess_delivery == eprosima::fastdds::INTRAPROCESS_OFF) return;
   settings.intraprocess_delivery = eprosima::fastdds::INTRAPROCESS_OFF;
-  eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->set_library_settings(settings);
+  if (factory->set_library_settings(settings) != kOk)
+    throw std::logic_error("disable_intraprocess_delivery: called after a participant was enabled");
 }
 
 /// Adds the discovery server number `id` at `locator` (Fast DDS 3 needs no server GUID prefix).
