@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "rsg/dds/fastdds_compat.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::dds {

@@ -15,7 +15,7 @@
 #include <string_view>
 #include <vector>
 
-#include "rsg/dds/fastdds_compat.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg_ros2_type_hashes.hpp"
 
 namespace rsg::gateway {

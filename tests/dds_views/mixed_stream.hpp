@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "random_state.hpp"
-#include "rsg/dds/fastdds_compat.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/state_values.hpp"
 

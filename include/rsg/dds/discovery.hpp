@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "rsg/dds/fastdds_compat.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/error.hpp"
 #include "rsg/transport/host_port.hpp"  // parse_discovery_server, parse_peer, kGatewayParticipantIds
 

@@ -7,7 +7,7 @@
 #include <cstring>
 
 #include "recording_schemas.hpp"
-#include "rsg/dds/fastdds_compat.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 
 namespace rsg::tools::record {
 namespace {

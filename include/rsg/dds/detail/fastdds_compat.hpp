@@ -1,3 +1,6 @@
+// INTERNAL, not part of rsg's API: installed only because rsg's public DDS headers include it; its
+// names may change or go in any release. Do not include it from your code.
+//
 // The one place where Fast DDS 2.x and 3.x differ for rsg (docs/fastdds-versions.md).
 //
 // rsg builds against Fast DDS 2.x (package `fastrtps`: Debian 12's 2.9.1, ROS 2 Jazzy's 2.14) or 3.x
