@@ -52,7 +52,8 @@ TEST(Discovery, TheXmlExampleIsTheSameClient) {
             rsg::dds::kOk);
   fdds::DomainParticipantQos from_flag;
   dds::apply_discovery(servers({"127.0.0.1:11811"}), 0, from_flag);
-  EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.discoveryProtocol, dds::DiscoveryProtocol::CLIENT);
+  EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.discoveryProtocol,
+            dds::DiscoveryProtocol::CLIENT);
   EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.m_DiscoveryServers,
             from_flag.wire_protocol().builtin.discovery_config.m_DiscoveryServers);
   // Both run the discovery cycle every 50 ms, not Fast DDS's 450 (docs/scaling.md).

@@ -3,8 +3,6 @@
 
 #include <gtest/gtest.h>
 
-#include "rsg/transport/udp_socket.hpp"
-
 namespace rsg {
 namespace {
 
@@ -50,14 +48,6 @@ TEST(HostPort, ADiscoveryServerIdIsOptional) {
   const wire::Parsed<transport::DiscoveryServer> without = transport::parse_discovery_server("h:1");
   ASSERT_TRUE(without) << without.error();
   EXPECT_FALSE(without->id.has_value());
-}
-
-TEST(HostPort, EndpointParseUsesTheSameSyntax) {
-  EXPECT_EQ(transport::Endpoint::parse(":0").to_string(), "0.0.0.0:0");
-  EXPECT_EQ(transport::Endpoint::parse("*:17000").to_string(), "0.0.0.0:17000");
-  EXPECT_EQ(transport::Endpoint::parse("[::1]:9").to_string(), "[::1]:9");
-  EXPECT_THROW(transport::Endpoint::parse("127.0.0.1"), rsg::InputError);
-  EXPECT_THROW(transport::Endpoint::parse("127.0.0.1:x"), rsg::InputError);
 }
 
 }  // namespace

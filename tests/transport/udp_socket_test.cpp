@@ -13,10 +13,13 @@ namespace {
 
 using namespace std::chrono_literals;
 
+// The bind-address syntax of rsg/transport/host_port.hpp: HOST "" or "*" is any, port 0 the kernel's pick.
 TEST(Endpoint, ParsesV4V6AndRejectsNonsense) {
   EXPECT_EQ(transport::Endpoint::parse("127.0.0.1:7000").to_string(), "127.0.0.1:7000");
   EXPECT_EQ(transport::Endpoint::parse("[::1]:7000").to_string(), "[::1]:7000");
   EXPECT_EQ(transport::Endpoint::parse(":7000").to_string(), "0.0.0.0:7000");
+  EXPECT_EQ(transport::Endpoint::parse("*:17000").to_string(), "0.0.0.0:17000");
+  EXPECT_EQ(transport::Endpoint::parse(":0").to_string(), "0.0.0.0:0");
   EXPECT_THROW(transport::Endpoint::parse("127.0.0.1"), rsg::InputError);
   EXPECT_THROW(transport::Endpoint::parse("127.0.0.1:notaport"), rsg::InputError);
 }
