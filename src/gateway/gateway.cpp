@@ -12,6 +12,7 @@
 
 #include "realtime.hpp"
 #include "rsg/dds/discovery.hpp"
+#include "rsg/dds/owned.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/ros2.hpp"
 #include "rsg/error.hpp"
@@ -35,26 +36,45 @@ transport::Endpoint resolve(const std::string& flag, const std::string& host_por
   }
 }
 
-void load_and_check_profiles(const GatewayConfig& config) {
-  const std::filesystem::path profiles =
-      config.profiles.empty() ? dds::default_profiles_dir() : std::filesystem::path(config.profiles);
-  dds::load_profiles(profiles);
+std::filesystem::path profiles_of(const GatewayConfig& config) {
+  return config.profiles.empty() ? dds::default_profiles_dir() : std::filesystem::path(config.profiles);
+}
 
-  // Fast DDS only notices a missing profile when an entity is created from it; look first.
-  const auto require = [&](bool found, const std::string& kind, const std::string& name) {
-    if (!found) throw InputError(profiles.string() + ": no " + kind + " profile named '" + name + "'");
+InputError no_profile(const GatewayConfig& config, const std::string& kind, const std::string& name) {
+  return InputError(profiles_of(config).string() + ": no " + kind + " profile named '" + name + "'");
+}
+
+void load_and_check_profiles(const GatewayConfig& config) {
+  dds::load_profiles(profiles_of(config));
+  fdds::DomainParticipantQos qos;
+  if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
+          config.participant_profile, qos) != dds::kOk)
+    throw no_profile(config, "participant", config.participant_profile);
+}
+
+// Fast DDS only notices a missing writer or reader profile when an entity is created from it, after
+// some of the gateway exists; look first. The lookup needs a publisher or subscriber, and it is done
+// through the gateway's own participant: a throwaway participant that is never enabled keeps its
+// participant id reserved in Fast DDS 3 for the life of the process, and the gateway's own
+// participant would then collide with it.
+dds::Participant& check_entity_profiles(dds::Participant& participant, const GatewayConfig& config) {
+  const auto has_writer_profile = [&](const std::string& name) {
+    const dds::OwnedPublisher publisher = dds::own(participant, participant.publisher());
+    fdds::DataWriterQos qos;
+    return publisher->get_datawriter_qos_from_profile(name, qos) == dds::kOk;
   };
-  using dds::ProfileKind;
-  require(dds::profile_defined(ProfileKind::kParticipant, config.participant_profile), "participant",
-          config.participant_profile);
-  require(dds::profile_defined(ProfileKind::kDataWriter, config.status_profile), "data_writer",
-          config.status_profile);
-  if (config.has_ingress())
-    require(dds::profile_defined(ProfileKind::kDataWriter, config.writer_profile), "data_writer",
-            config.writer_profile);
-  if (config.has_egress())
-    require(dds::profile_defined(ProfileKind::kDataReader, config.reader_profile), "data_reader",
-            config.reader_profile);
+  const auto has_reader_profile = [&](const std::string& name) {
+    const dds::OwnedSubscriber subscriber = dds::own(participant, participant.subscriber());
+    fdds::DataReaderQos qos;
+    return subscriber->get_datareader_qos_from_profile(name, qos) == dds::kOk;
+  };
+  if (!has_writer_profile(config.status_profile))
+    throw no_profile(config, "data_writer", config.status_profile);
+  if (config.has_ingress() && !has_writer_profile(config.writer_profile))
+    throw no_profile(config, "data_writer", config.writer_profile);
+  if (config.has_egress() && !has_reader_profile(config.reader_profile))
+    throw no_profile(config, "data_reader", config.reader_profile);
+  return participant;
 }
 
 // A gateway restarted after a crash must not come back on its predecessor's ports: readers still
@@ -67,7 +87,7 @@ fdds::DomainParticipantQos participant_qos(const GatewayConfig& config) {
   fdds::DomainParticipantQos qos;
   if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(profile, qos) !=
       dds::kOk)
-    throw InputError("no participant profile named '" + profile + "'");
+    throw no_profile(config, "participant", profile);
   if (qos.wire_protocol().participant_id < 0)
     qos.wire_protocol().participant_id =
         static_cast<std::int32_t>(::getpid() % transport::kGatewayParticipantIds);
@@ -169,7 +189,8 @@ GatewaySetup prepare(const GatewayConfig& config) {
 Gateway::Gateway(const GatewaySetup& setup)
     : config_(setup.config),
       participant_(config_.domain, participant_qos(config_)),
-      status_(participant_, status_topic_of(config_), partitions_of(config_), config_.status_profile,
+      status_(check_entity_profiles(participant_, config_), status_topic_of(config_), partitions_of(config_),
+              config_.status_profile,
               config_.ros2 ? std::string(dds::kRos2GatewayStatusType) : std::string()) {
   if (setup.ingress) {
     ingress_.emplace(participant_, *setup.ingress);

@@ -12,7 +12,7 @@
 //   rsg::dds::kOk, Duration, kInfinite   return code and times
 //   rsg::dds::rtps                       the RTPS namespace (GUID_t, Locator_t, IPLocator, ...)
 //   rsg::dds::serialize, deserialize, max_serialized_size, is_plain, rename_type
-//   rsg::dds::succeeded, is_keyed, disable_intraprocess_delivery, profile_defined
+//   rsg::dds::succeeded, is_keyed, disable_intraprocess_delivery
 //   rsg::dds::load_xml_profiles_file
 //   rsg::dds::add_discovery_server, discovery_server_locator, discovery_server_prefix
 //
@@ -57,9 +57,6 @@
 #include <fastdds/rtps/attributes/ServerAttributes.h>
 #include <fastdds/rtps/common/SerializedPayload.h>
 #include <fastrtps/attributes/LibrarySettingsAttributes.h>
-#include <fastrtps/attributes/ParticipantAttributes.h>
-#include <fastrtps/attributes/PublisherAttributes.h>
-#include <fastrtps/attributes/SubscriberAttributes.h>
 #include <fastrtps/config.h>
 #include <fastrtps/types/TypeObjectFactory.h>
 #include <fastrtps/utils/IPLocator.h>
@@ -68,9 +65,6 @@
 #endif
 
 namespace rsg::dds {
-
-/// The kinds of XML profile rsg looks up by name.
-enum class ProfileKind { kParticipant, kDataWriter, kDataReader };
 
 #if RSG_FASTDDS_MAJOR >= 3
 
@@ -186,39 +180,6 @@ inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& q
   qos.wire_protocol().builtin.discovery_config.m_DiscoveryServers.push_back(locator);
 }
 
-/// Whether the loaded XML profiles define a `kind` profile named `name`. Fast DDS 3 keeps its XML
-/// parser private: the writer and reader profiles are looked up through a publisher and a subscriber
-/// of a participant that is never enabled (no socket, no traffic), made and deleted here.
-inline bool profile_defined(ProfileKind kind, const std::string& name) {
-  namespace fdds = eprosima::fastdds::dds;
-  auto* factory = fdds::DomainParticipantFactory::get_instance();
-  if (kind == ProfileKind::kParticipant) {
-    fdds::DomainParticipantQos qos;
-    return factory->get_participant_qos_from_profile(name, qos) == kOk;
-  }
-  fdds::DomainParticipantFactoryQos factory_qos;
-  factory->get_qos(factory_qos);
-  fdds::DomainParticipantFactoryQos disabled = factory_qos;
-  disabled.entity_factory().autoenable_created_entities = false;
-  factory->set_qos(disabled);
-  fdds::DomainParticipant* participant = factory->create_participant(0, fdds::PARTICIPANT_QOS_DEFAULT);
-  factory->set_qos(factory_qos);
-  if (!participant) return false;
-  bool found = false;
-  if (kind == ProfileKind::kDataWriter) {
-    fdds::DataWriterQos qos;
-    auto* publisher = participant->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
-    found = publisher && publisher->get_datawriter_qos_from_profile(name, qos) == kOk;
-  } else {
-    fdds::DataReaderQos qos;
-    auto* subscriber = participant->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
-    found = subscriber && subscriber->get_datareader_qos_from_profile(name, qos) == kOk;
-  }
-  participant->delete_contained_entities();
-  factory->delete_participant(participant);
-  return found;
-}
-
 #else  // Fast DDS 2.x
 
 namespace rtps = eprosima::fastrtps::rtps;
@@ -299,26 +260,6 @@ inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& q
   eprosima::fastdds::rtps::get_server_client_default_guidPrefix(static_cast<int>(id), remote.guidPrefix);
   remote.metatrafficUnicastLocatorList.push_back(locator);
   qos.wire_protocol().builtin.discovery_config.m_DiscoveryServers.push_back(remote);
-}
-
-inline bool profile_defined(ProfileKind kind, const std::string& name) {
-  using Profiles = eprosima::fastrtps::xmlparser::XMLProfileManager;
-  constexpr auto kOkXml = eprosima::fastrtps::xmlparser::XMLP_ret::XML_OK;
-  switch (kind) {
-    case ProfileKind::kParticipant: {
-      eprosima::fastrtps::ParticipantAttributes attributes;
-      return Profiles::fillParticipantAttributes(name, attributes, false) == kOkXml;
-    }
-    case ProfileKind::kDataWriter: {
-      eprosima::fastrtps::PublisherAttributes attributes;
-      return Profiles::fillPublisherAttributes(name, attributes, false) == kOkXml;
-    }
-    case ProfileKind::kDataReader: {
-      eprosima::fastrtps::SubscriberAttributes attributes;
-      return Profiles::fillSubscriberAttributes(name, attributes, false) == kOkXml;
-    }
-  }
-  return false;
 }
 
 #endif
