@@ -2,6 +2,7 @@
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/error.hpp"
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/selection.hpp"

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "realtime.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/discovery.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/profiles.hpp"

@@ -4,13 +4,11 @@
 // configuration (flags, file, profiles, addresses) is unusable, 1 when the machine refuses (the port
 // is taken, DDS refuses an entity); nothing is left running then. A refused real-time setting
 // (--rt-priority, --cpu) is a warning, not a failure.
-#include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <fstream>
-#include <iostream>
 #include <sstream>
 
 #include "config.hpp"
@@ -77,7 +75,7 @@ std::optional<int> parse_command_line(int argc, char** argv, GatewayConfig& conf
       app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {
       if (error.get_exit_code() == 0) return app.exit(error);  // --help
-      std::cerr << "rsg_gateway: " << error.what() << " (see --help)\n";
+      spdlog::error("{} (see --help)", error.what());
       return kExitUsage;
     }
     if (config_file.empty()) {
@@ -87,18 +85,17 @@ std::optional<int> parse_command_line(int argc, char** argv, GatewayConfig& conf
   }
 
   std::string text;
-  if (const int status = rsg::tools::run_reporting_errors("rsg_gateway",
-                                                          [&] {
-                                                            text = read_file(config_file);
-                                                            return kExitOk;
-                                                          });
+  if (const int status = rsg::tools::run_reporting_errors([&] {
+        text = read_file(config_file);
+        return kExitOk;
+      });
       status != kExitOk)
     return status;
   const rsg::gateway::ConfigResult parsed = rsg::gateway::parse_gateway_config(text);
   if (!parsed) {
-    std::cerr << "rsg_gateway: " << config_file;
-    if (parsed.error().line > 0) std::cerr << ':' << parsed.error().line;
-    std::cerr << ": " << parsed.error().message << '\n';
+    const auto& error = parsed.error();
+    spdlog::error("{}{}: {}", config_file, error.line > 0 ? ":" + std::to_string(error.line) : std::string(),
+                  error.message);
     return kExitUsage;
   }
   config = parsed.config();
@@ -111,20 +108,20 @@ std::optional<int> parse_command_line(int argc, char** argv, GatewayConfig& conf
 }  // namespace
 
 int main(int argc, char** argv) {
+  rsg::tools::init_logging("rsg_gateway");
   StopOnSignal::block_stop_signals(/*with_dump=*/true);
   GatewayConfig config;
   if (const auto exit_status = parse_command_line(argc, argv, config)) return *exit_status;
-
-  spdlog::set_default_logger(spdlog::stderr_logger_mt("rsg_gateway"));
   spdlog::set_level(spdlog::level::from_str(config.log_level));
 
-  return rsg::tools::run_reporting_errors("rsg_gateway", [&] {
+  return rsg::tools::run_reporting_errors([&] {
     const rsg::gateway::GatewaySetup setup = rsg::gateway::prepare(config);
     // SIGUSR1 writes the flight recorder's pcap file: the loop does it when it sees `dump`.
     std::atomic<bool> stop{false};
     std::atomic<bool> dump{false};
     const StopOnSignal signals([&stop] { stop = true; }, [&dump] { dump = true; });
     rsg::gateway::Gateway gateway(setup);
+    rsg::tools::log_with_timestamps();  // started: from here on a log of a running service
     rsg::gateway::enter_realtime_mode(config);
     gateway.run(stop, &dump);
     return kExitOk;

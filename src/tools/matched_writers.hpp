@@ -1,4 +1,4 @@
-// One stderr line whenever the number of writers a tool's reader is matched with changes, e.g.
+// One log line whenever the number of writers a tool's reader is matched with changes, e.g.
 // "rsg_echo: matched 1 writer of 'robot_state'".
 //
 // Discovery is not symmetric: a gateway may count a reader (and send to it) before that reader
@@ -7,10 +7,11 @@
 // security setting otherwise looks like silence), and a script or test starts the robot after it.
 #pragma once
 
+#include <spdlog/spdlog.h>
+
 #include <cstdint>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
-#include <iostream>
 #include <string>
 #include <utility>
 
@@ -18,7 +19,7 @@ namespace rsg::tools {
 
 class MatchedWriters {
  public:
-  MatchedWriters(std::string tool, std::string topic) : tool_(std::move(tool)), topic_(std::move(topic)) {}
+  explicit MatchedWriters(std::string topic) : topic_(std::move(topic)) {}
 
   /// Cheap enough to call once per wake-up of the tool's loop.
   void update(eprosima::fastdds::dds::DataReader& reader) {
@@ -26,12 +27,10 @@ class MatchedWriters {
     reader.get_subscription_matched_status(matched);
     if (matched.current_count == writers_) return;
     writers_ = matched.current_count;
-    std::cerr << tool_ << ": matched " << writers_ << (writers_ == 1 ? " writer" : " writers") << " of '"
-              << topic_ << "'\n";
+    spdlog::info("matched {} {} of '{}'", writers_, writers_ == 1 ? "writer" : "writers", topic_);
   }
 
  private:
-  std::string tool_;
   std::string topic_;
   std::int32_t writers_ = 0;
 };

@@ -1,16 +1,26 @@
-// The exit statuses and error reporting every rsg executable shares (the tools and rsg_gateway), so
-// that scripts can tell a usage mistake (2) from a failure at run time (1) the same way for all.
+// The main() skeleton every rsg executable shares (the tools and rsg_gateway): one logger, the exit
+// statuses, and error reporting, so that scripts can tell a usage mistake (2) from a failure at run
+// time (1) the same way for all, and every line on stderr says which program wrote it.
+//
+//   int main(int argc, char** argv) {
+//     rsg::tools::init_logging("rsg_echo");
+//     ...
+//     if (const auto exit_status = rsg::tools::parse_command_line(app, argc, argv)) return *exit_status;
+//     return rsg::tools::run_reporting_errors([&] { ...; return rsg::tools::kExitOk; });
+//   }
 #pragma once
+
+#include <spdlog/pattern_formatter.h>
+#include <spdlog/sinks/stdout_sinks.h>
+#include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
 #include <exception>
-#include <iostream>
+#include <memory>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
-#include <vector>
 
 #include "rsg/error.hpp"
 
@@ -20,6 +30,39 @@ namespace rsg::tools {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailure = 1;
 inline constexpr int kExitUsage = 2;
+
+namespace detail {
+
+// The `%*` of kToolPattern: "warning: " before a warning, nothing otherwise (an error is the
+// tool's last word and needs no label; an info line is what the tool did).
+class WarningLabel final : public spdlog::custom_flag_formatter {
+ public:
+  void format(const spdlog::details::log_msg& message, const std::tm& /*time*/,
+              spdlog::memory_buf_t& out) override {
+    if (message.level != spdlog::level::warn) return;
+    constexpr std::string_view kLabel = "warning: ";
+    out.append(kLabel.data(), kLabel.data() + kLabel.size());
+  }
+  std::unique_ptr<custom_flag_formatter> clone() const override { return std::make_unique<WarningLabel>(); }
+};
+
+}  // namespace detail
+
+/// Makes spdlog's default logger the executable's: every line on stderr, as "<tool>: <message>"
+/// ("<tool>: warning: <message>" for a warning), at level info. Call it first in main().
+inline void init_logging(std::string_view tool) {
+  auto logger =
+      std::make_shared<spdlog::logger>(std::string(tool), std::make_shared<spdlog::sinks::stderr_sink_mt>());
+  auto formatter = std::make_unique<spdlog::pattern_formatter>();
+  formatter->add_flag<detail::WarningLabel>('*').set_pattern("%n: %*%v");
+  logger->set_formatter(std::move(formatter));
+  logger->flush_on(spdlog::level::trace);  // a line is written when it is logged, as std::cerr did
+  spdlog::set_default_logger(std::move(logger));
+}
+
+/// For a long-running process once it has started (rsg_gateway): each line also carries its time
+/// and level, "[2026-11-24 23:31:50.262] [rsg_gateway] [info] ...", for a log read afterwards.
+inline void log_with_timestamps() { spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%l] %v"); }
 
 /// Parses the command line; returns the exit status when the tool must stop here (--help: 0, a
 /// parse error: 2, with CLI11's message), or nothing to go on.
@@ -40,14 +83,14 @@ inline int exit_status_of(const std::exception& error) noexcept {
   return rsg_error != nullptr && rsg_error->kind() == rsg::Error::Kind::kInput ? kExitUsage : kExitFailure;
 }
 
-/// Runs `body` (which returns the exit status) and turns what it throws into "<tool>: <what>" on
-/// stderr and exit_status_of() it.
+/// Runs `body` (which returns the exit status) and turns what it throws into an error logged as
+/// "<tool>: <what>" (init_logging) and exit_status_of() it.
 template <class Body>
-int run_reporting_errors(std::string_view tool, Body&& body) {
+int run_reporting_errors(Body&& body) {
   try {
     return std::forward<Body>(body)();
   } catch (const std::exception& error) {
-    std::cerr << tool << ": " << error.what() << '\n';
+    spdlog::error("{}", error.what());
     return exit_status_of(error);
   }
 }

@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "random_state.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
 

@@ -31,6 +31,7 @@
 #include "ingress.hpp"
 #include "pcap_file.hpp"
 #include "random_state.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/ros2.hpp"
 #include "rsg/wire/frame.hpp"

@@ -48,6 +48,7 @@
 #include <vector>
 
 #include "random_state.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"

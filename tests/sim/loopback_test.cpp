@@ -3,9 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <sstream>
 #include <thread>
 
+#include "captured_log.hpp"
 #include "rsg/transport/udp_socket.hpp"
 #include "simulator.hpp"
 #include "udp_stream.hpp"
@@ -48,7 +48,7 @@ TEST_F(Loopback, EveryFrameArrivesAndDecodes) {
 
 TEST_F(Loopback, SelectionRequestToTheSourceAddressTakesEffect) {
   Simulator sim(SimConfig{});
-  std::ostringstream log;
+  const test::CapturedLog log;
   sim.step(link_);
   transport::Endpoint robot;
   ASSERT_TRUE(receive(&robot));
@@ -65,13 +65,13 @@ TEST_F(Loopback, SelectionRequestToTheSourceAddressTakesEffect) {
   // Both datagrams are queued on the loopback before poll_requests looks, but allow for a slow kernel.
   for (int attempt = 0; attempt < 500 && sim.report().selection_requests + sim.report().invalid_requests < 2;
        ++attempt) {
-    link_.poll_requests(sim, log);
+    link_.poll_requests(sim);
     if (sim.report().selection_requests + sim.report().invalid_requests < 2)
       std::this_thread::sleep_for(10ms);
   }
   EXPECT_EQ(sim.report().selection_requests, 1U);
   EXPECT_EQ(sim.report().invalid_requests, 1U);
-  EXPECT_NE(log.str().find("q,time"), std::string::npos) << log.str();
+  EXPECT_NE(log.text().find("q,time"), std::string::npos) << log.text();
 
   sim.step(link_);
   const wire::DecodeResult decoded = receive();
@@ -89,10 +89,9 @@ TEST_F(Loopback, StreamStopsAtTheCountAndSendsThemAll) {
     return joints;
   }());
   Simulator sim(config);
-  std::ostringstream log;
   const std::atomic<bool> stop{false};
   receiver_.set_receive_buffer(1 << 20);
-  stream(sim, link_, {.count = 200, .duration = std::nullopt}, stop, log);
+  stream(sim, link_, {.count = 200, .duration = std::nullopt}, stop);
   // Only what the sender did is asserted: whether the kernel kept all 200 is not this test's business.
   EXPECT_EQ(sim.frames(), 200U);
   EXPECT_EQ(sim.report().sent, 200U);
@@ -101,9 +100,8 @@ TEST_F(Loopback, StreamStopsAtTheCountAndSendsThemAll) {
 
 TEST_F(Loopback, StreamReturnsAtOnceWhenStopped) {
   Simulator sim(SimConfig{});
-  std::ostringstream log;
   const std::atomic<bool> stop{true};
-  stream(sim, link_, {}, stop, log);
+  stream(sim, link_, {}, stop);
   EXPECT_EQ(sim.frames(), 0U);
 }
 

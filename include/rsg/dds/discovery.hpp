@@ -17,7 +17,6 @@
 #include <string>
 #include <vector>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/error.hpp"
 #include "rsg/transport/host_port.hpp"  // parse_discovery_server, parse_peer, kGatewayParticipantIds
 

@@ -27,7 +27,6 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <string>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::dds {

@@ -24,6 +24,7 @@
 #include "discovery_cli.hpp"
 #include "live_table.hpp"
 #include "matched_writers.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
@@ -209,7 +210,7 @@ int run(const Options& options) {
   reader_condition.set_enabled_statuses(fdds::StatusMask::data_available()
                                         << fdds::StatusMask::requested_incompatible_qos()
                                         << fdds::StatusMask::subscription_matched());
-  rsg::tools::MatchedWriters matched_writers("rsg_echo", read_topic);
+  rsg::tools::MatchedWriters matched_writers(read_topic);
   fdds::WaitSet waitset;
   waitset.attach_condition(reader_condition);
   waitset.attach_condition(stop);
@@ -238,9 +239,10 @@ int run(const Options& options) {
     fdds::RequestedIncompatibleQosStatus incompatible;
     if (reader->get_requested_incompatible_qos_status(incompatible) == rsg::dds::kOk &&
         incompatible.total_count_change > 0)
-      std::cerr << "rsg_echo: a writer of '" << topic_name << "' does not match reader profile '"
-                << qos_profile << "': its " << policy_name(incompatible.last_policy_id)
-                << " offer is below this reader's request\n";
+      spdlog::warn(
+          "a writer of '{}' does not match reader profile '{}': its {} offer is below this reader's "
+          "request",
+          topic_name, qos_profile, policy_name(incompatible.last_policy_id));
 
     // Take everything available: at 1 kHz a wake-up finds several samples.
     bool done = false;
@@ -260,7 +262,7 @@ int run(const Options& options) {
     sink.flush(now, done);
     if (done) return kExitOk;
     if (options.timeout_seconds > 0 && now - last_sample >= timeout) {
-      std::cerr << "rsg_echo: no sample on '" << read_topic << "' for " << options.timeout_seconds << " s\n";
+      spdlog::error("no sample on '{}' for {} s", read_topic, options.timeout_seconds);
       return kExitFailure;
     }
   }
@@ -269,6 +271,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  rsg::tools::init_logging("rsg_echo");
   CLI::App app{"Prints the RobotState samples of a topic, or of a group view of it.", "rsg_echo"};
   app.footer(
       "Views: view_poses (group 0), view_load_and_elbow (1), view_joints (2), view_contact (3), "
@@ -279,7 +282,7 @@ int main(int argc, char** argv) {
   Options options;
   add_options(app, options);
   if (const auto stop = parse_command_line(app, argc, argv)) return *stop;
-  return run_reporting_errors("rsg_echo", [&] {
+  return run_reporting_errors([&] {
     rsg::dds::load_profiles(options.profiles, options.participant_profile);
     return run(options);
   });

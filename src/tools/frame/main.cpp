@@ -8,6 +8,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "tool_main.hpp"
 
 namespace {
 
@@ -92,12 +93,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   request->add_flag("--hex,--hex-lines", options.hex_lines, "Write one hex line instead of binary");
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // CLI11 has a distinct code per parse error; callers only need "usage error".
-    return app.exit(e) == 0 ? kExitOk : kExitUsage;
-  }
+  if (const auto exit_status = rsg::tools::parse_command_line(app, argc, argv)) return *exit_status;
 
   const FrameFormat format = options.hex_lines ? FrameFormat::kHexLines : FrameFormat::kBinary;
   if (request->parsed())

@@ -9,7 +9,6 @@
 #include <chrono>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <iostream>
 #include <map>
 #include <optional>
 
@@ -20,6 +19,7 @@
 #include "monitor_options.hpp"
 #include "monitor_readers.hpp"
 #include "recording.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
@@ -138,7 +138,7 @@ class Recording {
                                        .sync = options_.fsync});
     channels_ = rsg::tools::record::add_channels(*writer_, profile_, options_.topic, options_.status_topic);
     ++files;
-    if (split_bytes_ != 0) std::cerr << "rsg_record: writing " << path.string() << "\n";
+    if (split_bytes_ != 0) spdlog::info("writing {}", path.string());
   }
 
   void finish_file() {
@@ -249,16 +249,16 @@ int recover(const Options& options) {
   const auto result = rsg::mcap::recover(damaged.bytes(), options.out,
                                          {.chunk_bytes = options.chunk_bytes, .sync = options.fsync});
   using Status = rsg::mcap::ScanResult::Status;
-  std::cerr << "rsg_record: recovered " << result.written.messages << " messages in " << result.written.chunks
-            << " chunks from " << options.recover.string() << " into " << options.out.string();
-  if (result.unreadable > 0) std::cerr << "; left out " << result.unreadable << " on undescribed channels";
-  std::cerr << "\n";
+  spdlog::info("recovered {} messages in {} chunks from {} into {}{}", result.written.messages,
+               result.written.chunks, options.recover.string(), options.out.string(),
+               result.unreadable > 0 ? fmt::format("; left out {} on undescribed channels", result.unreadable)
+                                     : std::string());
   if (result.scan.status == Status::truncated)
-    std::cerr << "rsg_record: " << options.recover.string() << " ends early (" << result.scan.error
-              << " at byte " << result.scan.offset << "): everything before it was recovered\n";
+    spdlog::warn("{} ends early ({} at byte {}): everything before it was recovered",
+                 options.recover.string(), result.scan.error, result.scan.offset);
   if (result.scan.status == Status::malformed) {
-    std::cerr << "rsg_record: " << options.recover.string() << " is damaged at byte " << result.scan.offset
-              << ": " << result.scan.error << "; what came before was recovered\n";
+    spdlog::error("{} is damaged at byte {}: {}; what came before was recovered", options.recover.string(),
+                  result.scan.offset, result.scan.error);
     return kExitFailure;
   }
   return kExitOk;
@@ -275,7 +275,7 @@ int run(const Options& options, rsg::tools::record::Profile profile) {
   const auto start = std::chrono::steady_clock::now();
   const auto duration = std::chrono::duration<double>(options.duration_s);
   LossCounter loss;
-  rsg::tools::MatchedWriters matched_writers("rsg_record", options.topic);
+  rsg::tools::MatchedWriters matched_writers(options.topic);
   rsg::RobotState state;
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
@@ -303,7 +303,7 @@ int run(const Options& options, rsg::tools::record::Profile profile) {
     write_what_was_received();
     recording.close();
   } catch (const rsg::mcap::WriteError& error) {
-    std::cerr << "rsg_record: " << error.what() << "\n";
+    spdlog::error("{}", error.what());
     recording.count_failed_file();
     exit_code = kExitFailure;
   }
@@ -313,23 +313,25 @@ int run(const Options& options, rsg::tools::record::Profile profile) {
   const double ratio = recording.compressed == 0 ? 0
                                                  : static_cast<double>(recording.uncompressed) /
                                                        static_cast<double>(recording.compressed);
-  std::cerr << "rsg_record: " << recording.messages << " messages in " << recording.chunks << " chunks, "
-            << recording.files << (recording.files == 1 ? " file, " : " files, ") << recording.file_bytes
-            << " bytes; compression ratio " << ratio << "; received " << recording.states << " states, "
-            << recording.statuses << " statuses"
-            << "; dropped " << (options.view_profile.empty() ? loss.gaps : 0) << " (sequence gaps), "
-            << lost.total_count << " (lost in DDS)";
-  if (recording.raised > 0) std::cerr << "; " << recording.raised << " log times raised to keep their order";
+  std::string summary = fmt::format(
+      "{} messages in {} chunks, {} {}, {} bytes; compression ratio {:g}; received {} states, {} statuses; "
+      "dropped {} (sequence gaps), {} (lost in DDS)",
+      recording.messages, recording.chunks, recording.files, recording.files == 1 ? "file" : "files",
+      recording.file_bytes, ratio, recording.states, recording.statuses,
+      options.view_profile.empty() ? loss.gaps : 0, lost.total_count);
+  if (recording.raised > 0)
+    summary += fmt::format("; {} log times raised to keep their order", recording.raised);
   if (options.fsync)
-    std::cerr << "; " << recording.syncs << " fsyncs in " << static_cast<double>(recording.sync_ns) / 1e6
-              << " ms";
-  std::cerr << "\n";
+    summary +=
+        fmt::format("; {} fsyncs in {:g} ms", recording.syncs, static_cast<double>(recording.sync_ns) / 1e6);
+  spdlog::info("{}", summary);
   return exit_code;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  rsg::tools::init_logging("rsg_record");
   CLI::App app{"Records RobotState and GatewayStatus samples into an MCAP file.", "rsg_record"};
   app.footer(
       "Exit status: 0 after --duration or on SIGINT/SIGTERM (the file finished), 1 when the file cannot be "
@@ -341,27 +343,27 @@ int main(int argc, char** argv) {
   if (const auto stop = parse_command_line(app, argc, argv)) return *stop;
   if (!options.recover.empty()) {
     if (fs::exists(options.out) && fs::equivalent(options.out, options.recover)) {
-      std::cerr << "rsg_record: --recover writes a new file: --out must be another path\n";
+      spdlog::error("--recover writes a new file: --out must be another path");
       return kExitUsage;
     }
-    return run_reporting_errors("rsg_record", [&] { return recover(options); });
+    return run_reporting_errors([&] { return recover(options); });
   }
   const auto profile = rsg::tools::record::parse_profile(options.profile);
   if (!profile) {
-    std::cerr << "rsg_record: --profile must be omgidl or ros2, not '" << options.profile << "'\n";
+    spdlog::error("--profile must be omgidl or ros2, not '{}'", options.profile);
     return kExitUsage;
   }
   if (*profile == rsg::tools::record::Profile::ros2 && !rsg::tools::record::has_ros2_schemas()) {
-    std::cerr << "rsg_record: this build has no ros2/rsg_msgs/msg/RobotState.msg, so no --profile ros2\n";
+    spdlog::error("this build has no ros2/rsg_msgs/msg/RobotState.msg, so no --profile ros2");
     return kExitUsage;
   }
   if (*profile == rsg::tools::record::Profile::ros2 && !options.status_topic.empty() &&
       !rsg::tools::record::has_ros2_status_schema())
-    std::cerr
-        << "rsg_record: warning: this build has no ros2/rsg_msgs/msg/GatewayStatus.msg, so a --profile ros2 "
-           "recording leaves '"
-        << options.status_topic << "' out\n";
-  return run_reporting_errors("rsg_record", [&] {
+    spdlog::warn(
+        "this build has no ros2/rsg_msgs/msg/GatewayStatus.msg, so a --profile ros2 recording leaves "
+        "'{}' out",
+        options.status_topic);
+  return run_reporting_errors([&] {
     rsg::dds::load_profiles(options.profiles, options.participant_profile);
     return run(options, *profile);
   });

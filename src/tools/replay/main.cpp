@@ -13,7 +13,6 @@
 #include <cmath>
 #include <cstring>
 #include <fastdds/dds/publisher/DataWriter.hpp>
-#include <iostream>
 #include <optional>
 #include <thread>
 #include <unordered_set>
@@ -21,6 +20,7 @@
 #include "discovery_cli.hpp"
 #include "mcap_reader.hpp"
 #include "recording.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
@@ -76,7 +76,7 @@ class UdpOutput final : public Output {
       return true;
     }
     if (socket_.send_to({frame_.data(), frame.size}, to_)) return true;
-    std::cerr << "rsg_replay: cannot send to " << to_.to_string() << ": " << std::strerror(errno) << "\n";
+    spdlog::error("cannot send to {}: {}", to_.to_string(), std::strerror(errno));
     return false;
   }
   std::uint64_t unencodable = 0;
@@ -100,7 +100,7 @@ class DdsOutput final : public Output {
   }
   bool send(const rsg::RobotState& sample) override {
     if (rsg::dds::succeeded(writer_->write(const_cast<rsg::RobotState*>(&sample)))) return true;
-    std::cerr << "rsg_replay: the DDS writer refused a sample\n";
+    spdlog::error("the DDS writer refused a sample");
     return false;
   }
   fdds::DataWriter& writer() { return *writer_; }
@@ -109,7 +109,7 @@ class DdsOutput final : public Output {
   /// until every matched reader has acknowledged.
   void finish() override {
     if (writer_->wait_for_acknowledgments(rsg::dds::Duration(5, 0)) != rsg::dds::kOk)
-      std::cerr << "rsg_replay: not every reader acknowledged the last samples within 5 s\n";
+      spdlog::warn("not every reader acknowledged the last samples within 5 s");
   }
 
  private:
@@ -230,8 +230,7 @@ void wait_for_readers(fdds::DataWriter& writer, int readers, const std::atomic<b
          writer.get_publication_matched_status(matched) == rsg::dds::kOk && matched.current_count < readers)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   if (matched.current_count < readers)
-    std::cerr << "rsg_replay: only " << matched.current_count << " of " << readers
-              << " readers matched; playing anyway\n";
+    spdlog::warn("only {} of {} readers matched; playing anyway", matched.current_count, readers);
 }
 
 int run(const Options& options) {
@@ -264,19 +263,17 @@ int run(const Options& options) {
            player.sent > sent_before);
 
   output->finish();
-  std::cerr << "rsg_replay: sent " << player.sent << " samples";
+  std::string summary = fmt::format("sent {} samples", player.sent);
   if (player.undecodable > 0)
-    std::cerr << ", skipped " << player.undecodable << " that do not decode as RobotState";
+    summary += fmt::format(", skipped {} that do not decode as RobotState", player.undecodable);
   if (auto* udp = dynamic_cast<UdpOutput*>(output.get()); udp && udp->unencodable > 0)
-    std::cerr << ", skipped " << udp->unencodable << " that no valid frame describes";
-  std::cerr << "\n";
+    summary += fmt::format(", skipped {} that no valid frame describes", udp->unencodable);
+  spdlog::info("{}", summary);
   if (result.status == Status::truncated)
-    std::cerr << "rsg_replay: warning: " << options.file
-              << " ends early (a recorder that was killed?): " << result.error << " at byte " << result.offset
-              << "; played everything before it\n";
+    spdlog::warn("{} ends early (a recorder that was killed?): {} at byte {}; played everything before it",
+                 options.file, result.error, result.offset);
   if (result.status == Status::malformed) {
-    std::cerr << "rsg_replay: " << options.file << " is damaged at byte " << result.offset << ": "
-              << result.error << "\n";
+    spdlog::error("{} is damaged at byte {}: {}", options.file, result.offset, result.error);
     return kExitFailure;
   }
   return player.failed ? kExitFailure : kExitOk;
@@ -285,6 +282,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  rsg::tools::init_logging("rsg_replay");
   CLI::App app{"Plays an rsg_record MCAP file back as raw frames (--to) or DDS samples (--domain).",
                "rsg_replay"};
   app.footer(
@@ -297,5 +295,5 @@ int main(int argc, char** argv) {
     app.exit(CLI::RequiredError("--to or --domain"));
     return kExitUsage;
   }
-  return run_reporting_errors("rsg_replay", [&] { return run(options); });
+  return run_reporting_errors([&] { return run(options); });
 }

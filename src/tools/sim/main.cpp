@@ -173,9 +173,9 @@ int run_replay(const Options& options) {
   std::atomic<bool> stop{false};
   const rsg::tools::StopOnSignal signals([&stop] { stop = true; });
   const rsg::tools::sim::ReplayReport report =
-      rsg::tools::sim::replay(options.replay_path, socket, peer, options.replay, stop, std::cerr);
-  std::cerr << "rsg_sim: replayed " << report.sent << " datagrams to port " << report.port << " ("
-            << report.passes << " complete passes, " << report.send_failures << " send failures)\n";
+      rsg::tools::sim::replay(options.replay_path, socket, peer, options.replay, stop);
+  spdlog::info("replayed {} datagrams to port {} ({} complete passes, {} send failures)", report.sent,
+               report.port, report.passes, report.send_failures);
   return report.send_failures == 0 ? kExitOk : kExitFailure;
 }
 
@@ -200,6 +200,7 @@ void check_probabilities(const rsg::tools::sim::FaultConfig& faults) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  rsg::tools::init_logging("rsg_sim");
   rsg::tools::StopOnSignal::block_stop_signals();
   CLI::App app{"Simulated Franka Panda: streams SEND_BUF frames (docs/protocol.md) over UDP.", "rsg_sim"};
   app.footer(std::string(kScheduleHelp) +
@@ -217,7 +218,7 @@ int main(int argc, char** argv) {
   }
   config.pause = std::chrono::milliseconds(options.pause_ms);
 
-  return rsg::tools::run_reporting_errors("rsg_sim", [&] {
+  return rsg::tools::run_reporting_errors([&] {
     if (!options.replay_path.empty()) return run_replay(options);
     const rsg::transport::Endpoint peer = rsg::transport::Endpoint::parse(options.to);
     rsg::transport::UdpSocket socket = rsg::transport::UdpSocket::for_sending_to(peer);
@@ -242,10 +243,10 @@ int main(int argc, char** argv) {
 
     std::atomic<bool> stop{false};
     const rsg::tools::StopOnSignal signals([&stop] { stop = true; });
-    std::cerr << "rsg_sim: sending to " << peer.to_string() << " at " << config.rate_hz << " Hz\n";
-    rsg::tools::sim::stream(sim, link, limits, stop, std::cerr);
+    spdlog::info("sending to {} at {} Hz", peer.to_string(), config.rate_hz);
+    rsg::tools::sim::stream(sim, link, limits, stop);
 
-    std::cerr << "rsg_sim: " << sim.report().summary() << "\n";
+    spdlog::info("{}", sim.report().summary());
     if (!options.report_path.empty()) {
       std::ofstream report(options.report_path);
       report << sim.report().to_json() << "\n";

@@ -1,5 +1,7 @@
 #include "replay.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 #include <stdexcept>
 
@@ -27,11 +29,11 @@ std::uint16_t first_frame_port(const std::string& path) {
 }  // namespace
 
 ReplayReport replay(const std::string& path, transport::UdpSocket& socket, const transport::Endpoint& to,
-                    const ReplayOptions& options, const std::atomic<bool>& stop, std::ostream& log) {
+                    const ReplayOptions& options, const std::atomic<bool>& stop) {
   ReplayReport report;
   report.port = options.port ? *options.port : first_frame_port(path);
-  log << "rsg_sim: replaying the datagrams to port " << report.port << " in '" << path << "' to "
-      << to.to_string() << " at " << options.speed << "x\n";
+  spdlog::info("replaying the datagrams to port {} in '{}' to {} at {}x", report.port, path, to.to_string(),
+               options.speed);
 
   Clock::time_point pass_start = Clock::now();
   while (!stop.load(std::memory_order_relaxed)) {

@@ -5,7 +5,6 @@
 #include <atomic>
 #include <cstdint>
 #include <optional>
-#include <ostream>
 #include <string>
 
 #include "rsg/transport/udp_socket.hpp"
@@ -32,6 +31,6 @@ struct ReplayReport {
 /// Invalid frames are sent as they are: a replay reproduces what the robot sent. Throws
 /// std::runtime_error for an unreadable file or one without a SEND_BUF frame to find the port by.
 ReplayReport replay(const std::string& path, transport::UdpSocket& socket, const transport::Endpoint& to,
-                    const ReplayOptions& options, const std::atomic<bool>& stop, std::ostream& log);
+                    const ReplayOptions& options, const std::atomic<bool>& stop);
 
 }  // namespace rsg::tools::sim

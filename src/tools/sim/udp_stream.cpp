@@ -1,5 +1,6 @@
 #include "udp_stream.hpp"
 
+#include <spdlog/spdlog.h>
 #include <sys/socket.h>
 
 #include <algorithm>
@@ -57,22 +58,21 @@ bool UdpLink::send(std::span<const std::uint8_t> datagram) {
   return sent;
 }
 
-void UdpLink::poll_requests(Simulator& sim, std::ostream& log) {
+void UdpLink::poll_requests(Simulator& sim) {
   transport::Endpoint from;
   while (const auto size = socket_.receive(request_, &from, std::chrono::milliseconds(0))) {
     const std::size_t kept = std::min(*size, request_.size());
     const wire::SelectionRequestResult request = sim.handle_request({request_.data(), kept});
     if (request)
-      log << "rsg_sim: selection request from " << from.to_string() << ": now sending "
-          << describe(request.selection) << "\n";
+      spdlog::info("selection request from {}: now sending {}", from.to_string(),
+                   describe(request.selection));
     else
-      log << "rsg_sim: ignored an invalid selection request from " << from.to_string() << " ("
-          << wire::to_string(request.error.category()) << ": " << request.error.message() << ")\n";
+      spdlog::info("ignored an invalid selection request from {} ({}: {})", from.to_string(),
+                   wire::to_string(request.error.category()), request.error.message());
   }
 }
 
-void stream(Simulator& sim, UdpLink& link, const StreamLimits& limits, const std::atomic<bool>& stop,
-            std::ostream& log) {
+void stream(Simulator& sim, UdpLink& link, const StreamLimits& limits, const std::atomic<bool>& stop) {
   const double rate = sim.config().rate_hz;
   const nanoseconds spin_window = rate > kSpinAboveHz ? kSpinWindow : nanoseconds::zero();
   const auto poll_every = static_cast<std::uint64_t>(std::max(1.0, rate / kRequestPollsPerSecond));
@@ -86,12 +86,12 @@ void stream(Simulator& sim, UdpLink& link, const StreamLimits& limits, const std
     if (stop.load(std::memory_order_relaxed)) break;
     const std::uint64_t restarts = sim.report().restarts;
     const nanoseconds pause = sim.step(link);
-    if (sim.report().restarts != restarts) log << "rsg_sim: robot restarted before frame " << frame << "\n";
+    if (sim.report().restarts != restarts) spdlog::info("robot restarted before frame {}", frame);
     if (pause > nanoseconds::zero())
-      log << "rsg_sim: link down for " << std::chrono::duration<double, std::milli>(pause).count()
-          << " ms after frame " << frame << "\n";
+      spdlog::info("link down for {:g} ms after frame {}",
+                   std::chrono::duration<double, std::milli>(pause).count(), frame);
     paused += pause;
-    if (frame % poll_every == 0) link.poll_requests(sim, log);
+    if (frame % poll_every == 0) link.poll_requests(sim);
   }
   sim.finish(link);
 }

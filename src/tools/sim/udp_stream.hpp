@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cstdint>
 #include <optional>
-#include <ostream>
 
 #include "pcap_file.hpp"
 #include "rsg/transport/udp_socket.hpp"
@@ -25,7 +24,7 @@ class UdpLink final : public DatagramSink {
   /// Also writes every datagram sent into `writer` (null: stop), stamped with the wall clock.
   void capture_to(capture::PcapWriter* writer) { capture_ = writer; }
   /// Hands every datagram waiting on the socket to `sim` as a selection request and logs the outcome.
-  void poll_requests(Simulator& sim, std::ostream& log);
+  void poll_requests(Simulator& sim);
 
  private:
   transport::UdpSocket& socket_;
@@ -50,7 +49,6 @@ void wait_until(std::chrono::steady_clock::time_point deadline, std::chrono::nan
 /// selection requests about once a millisecond. Above 2 kHz the last stretch before each deadline
 /// is spent yielding instead of sleeping, because a sleeping thread wakes up tens of microseconds
 /// late. Ends with `sim.finish`.
-void stream(Simulator& sim, UdpLink& link, const StreamLimits& limits, const std::atomic<bool>& stop,
-            std::ostream& log);
+void stream(Simulator& sim, UdpLink& link, const StreamLimits& limits, const std::atomic<bool>& stop);
 
 }  // namespace rsg::tools::sim

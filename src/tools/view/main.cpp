@@ -7,11 +7,12 @@
 //
 // Exit status: 0 on SIGINT/SIGTERM, 1 when the port cannot be opened or DDS fails, 2 on usage
 // errors (including unknown profiles).
+#include <spdlog/spdlog.h>
+
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fstream>
-#include <iostream>
 #include <optional>
 #include <sstream>
 
@@ -19,6 +20,7 @@
 #include "monitor_options.hpp"
 #include "monitor_readers.hpp"
 #include "recording.hpp"
+#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
 #include "rsg/transport/udp_socket.hpp"
@@ -84,8 +86,9 @@ std::vector<rsg::tools::view::WebFile> web_files(const Options& options) {
   };
   std::ifstream in(options.chart_js, std::ios::binary);
   if (!in) {
-    std::cerr << "rsg_view: warning: cannot read " << options.chart_js
-              << " (install libjs-chart.js or pass --chart-js): the page shows numbers but no plots\n";
+    spdlog::warn(
+        "cannot read {} (install libjs-chart.js or pass --chart-js): the page shows numbers but no plots",
+        options.chart_js);
     return files;
   }
   std::ostringstream body;
@@ -108,8 +111,7 @@ int run(const Options& options) {
   StopOnSignal::block_stop_signals();
   rsg::tools::view::ChannelSet channels(options.topic, options.status_topic);
   rsg::tools::view::Server server(options.server, channels.channels(), web_files(options));
-  std::cerr << "rsg_view: serving ws://" << options.server.host << ":" << server.port() << " and http://"
-            << options.server.host << ":" << server.port() << "/\n";
+  spdlog::info("serving ws://{0}:{1} and http://{0}:{1}/", options.server.host, server.port());
 
   rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery);
   rsg::tools::MonitorReaders readers(participant, options.topics());
@@ -124,7 +126,7 @@ int run(const Options& options) {
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
   bool summary_pending = false;
-  rsg::tools::MatchedWriters matched_writers("rsg_view", options.topic);
+  rsg::tools::MatchedWriters matched_writers(options.topic);
   while (!readers.stop_requested()) {
     readers.wait(kWakeUp);
     matched_writers.update(readers.state());
@@ -155,14 +157,13 @@ int run(const Options& options) {
       server.publish(channels.summary(), now_ns(), payload_of(summary.json(server.dropped())));
     }
   }
-  std::cerr << "rsg_view: received " << summary.samples() << " states; dropped " << server.dropped()
-            << " messages for slow clients\n";
+  spdlog::info("received {} states; dropped {} messages for slow clients", summary.samples(),
+               server.dropped());
   const auto counts = server.channel_counts();  // in the order of channels.channels()
   for (std::size_t i = 0; i < counts.size(); ++i) {
     const auto& channel = channels.channels()[i];
-    std::cerr << "rsg_view: channel " << channel.id << " " << channel.topic << " (" << channel.schema_name
-              << ", " << channel.schema_encoding << "): published " << counts[i].published << ", dropped "
-              << counts[i].dropped << "\n";
+    spdlog::info("channel {} {} ({}, {}): published {}, dropped {}", channel.id, channel.topic,
+                 channel.schema_name, channel.schema_encoding, counts[i].published, counts[i].dropped);
   }
   return kExitOk;
 }
@@ -170,6 +171,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  rsg::tools::init_logging("rsg_view");
   CLI::App app{"Serves RobotState and GatewayStatus to Foxglove, PlotJuggler and a live web page.",
                "rsg_view"};
   app.footer(
@@ -180,10 +182,10 @@ int main(int argc, char** argv) {
   try {
     split_listen(options.listen, options.server);
   } catch (const std::exception& error) {
-    std::cerr << "rsg_view: --listen: " << error.what() << '\n';
+    spdlog::error("--listen: {}", error.what());
     return kExitUsage;
   }
-  return run_reporting_errors("rsg_view", [&] {
+  return run_reporting_errors([&] {
     rsg::dds::load_profiles(options.profiles, options.participant_profile);
     return run(options);
   });

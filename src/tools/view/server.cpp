@@ -1,5 +1,7 @@
 #include "server.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/post.hpp>
@@ -10,7 +12,6 @@
 #include <chrono>
 #include <deque>
 #include <future>
-#include <iostream>
 #include <map>
 #include <optional>
 #include <set>
@@ -125,13 +126,13 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void on_accept(beast::error_code ec) {
     if (ec) return;  // never counted as a client
     if (hub_.sessions.size() >= hub_.options.max_clients) {
-      std::cerr << "rsg_view: refusing " << peer_ << ": already " << hub_.sessions.size() << " clients\n";
+      spdlog::warn("refusing {}: already {} clients", peer_, hub_.sessions.size());
       ws_.async_close(websocket::close_reason(websocket::close_code::try_again_later, "too many clients"),
                       [self = shared_from_this()](beast::error_code) {});
       return;
     }
     hub_.sessions.insert(shared_from_this());
-    std::cerr << "rsg_view: client " << peer_ << " connected (" << subprotocol_ << ")\n";
+    spdlog::info("client {} connected ({})", peer_, subprotocol_);
     send_text(foxglove::server_info("rsg_view", std::to_string(hub_.next_session++)));
     send_text(hub_.advertise);
     read();
@@ -146,8 +147,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void on_read(beast::error_code ec) {
     if (ec) {
       if (ec == websocket::error::message_too_big)
-        std::cerr << "rsg_view: client " << peer_ << " sent a message over "
-                  << hub_.options.max_client_message << " bytes: closed\n";
+        spdlog::warn("client {} sent a message over {} bytes: closed", peer_,
+                     hub_.options.max_client_message);
       return finish();
     }
     const auto now = std::chrono::steady_clock::now();
@@ -189,7 +190,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
           } else if constexpr (std::is_same_v<T, foxglove::Unsupported>) {
             send_text(foxglove::status(Level::error, "unsupported operation '" + message.op + "'"));
           } else {
-            std::cerr << "rsg_view: client " << peer_ << ": malformed message: " << message.reason << "\n";
+            spdlog::warn("client {}: malformed message: {}", peer_, message.reason);
             send_text(foxglove::status(Level::error, "malformed message: " + message.reason));
           }
         },
@@ -198,7 +199,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
   void send_text(std::string text) {
     if (control_.size() >= kMaxControlBacklog) {
-      std::cerr << "rsg_view: client " << peer_ << " reads none of its status messages: closed\n";
+      spdlog::warn("client {} reads none of its status messages: closed", peer_);
       return finish();
     }
     control_.push_back(std::move(text));
@@ -252,7 +253,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
         const std::string text = "dropped " + std::to_string(self->dropped_) +
                                  " messages: this connection reads slower than the data arrives (" +
                                  self->drops_by_topic() + ")";
-        std::cerr << "rsg_view: client " << self->peer_ << ": " << text << "\n";
+        spdlog::warn("client {}: {}", self->peer_, text);
         self->send_text(foxglove::status(Level::warning, text, "rsg_view.dropped"));
       }
       self->schedule_drop_report();
@@ -273,7 +274,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
   void finish() {
     if (hub_.sessions.erase(shared_from_this()) != 0)
-      std::cerr << "rsg_view: client " << peer_ << " disconnected (dropped " << dropped_ << " messages)\n";
+      spdlog::info("client {} disconnected (dropped {} messages)", peer_, dropped_);
     close();
   }
 

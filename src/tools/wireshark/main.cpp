@@ -6,7 +6,6 @@
 // The template holds the dissector's logic; the line @RSG_GENERATED_TABLES@ becomes the tables.
 #include <cstdio>
 #include <fstream>
-#include <iostream>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -84,11 +83,12 @@ std::string tables() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  rsg::tools::init_logging("rsg_wireshark_lua");
   if (argc != 3) {
-    std::cerr << "usage: rsg_wireshark_lua TEMPLATE OUTPUT\n";
+    spdlog::error("usage: rsg_wireshark_lua TEMPLATE OUTPUT");
     return rsg::tools::kExitUsage;
   }
-  return rsg::tools::run_reporting_errors("rsg_wireshark_lua", [&] {
+  return rsg::tools::run_reporting_errors([&] {
     std::ifstream in(argv[1], std::ios::binary);
     if (!in) throw rsg::InputError(std::string("cannot read '") + argv[1] + "'");
     std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "rsg/dds/detail/fastdds_compat.hpp"
+
 namespace rsg::bench {
 namespace fdds = eprosima::fastdds::dds;
 namespace {

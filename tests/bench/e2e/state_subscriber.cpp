@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "rsg/dds/detail/fastdds_compat.hpp"
+
 namespace rsg::bench {
 namespace fdds = eprosima::fastdds::dds;
 namespace {
