@@ -220,6 +220,7 @@ void Ingress::fill(GatewayStats& stats) const {
   stats.state_readers = static_cast<std::uint32_t>(matched.current_count);
   stats.source = source_.size() ? source_.to_string() : std::string();
   stats.standard_dropped = standard_topics_ ? standard_topics_->dropped() : 0;
+  stats.standard_readers = standard_topics_ ? standard_topics_->matched_readers() : 0;
 }
 
 void Ingress::log_rejections() {

@@ -107,6 +107,16 @@ void Ros2StandardTopics::create(Writer& writer, const std::optional<Output>& out
   writer.decimator.emplace(output->decimation);
 }
 
+std::uint32_t Ros2StandardTopics::matched_readers() const {
+  std::uint32_t readers = 0;
+  for (const Writer* output : {&joint_states_, &tf_, &wrench_}) {
+    fdds::PublicationMatchedStatus matched;
+    if (output->writer && output->writer->get_publication_matched_status(matched) == dds::kOk)
+      readers += static_cast<std::uint32_t>(matched.current_count);
+  }
+  return readers;
+}
+
 std::array<std::uint64_t, 3> Ros2StandardTopics::written() const {
   return {joint_states_.written.load(), tf_.written.load(), wrench_.written.load()};
 }

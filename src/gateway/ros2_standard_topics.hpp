@@ -59,6 +59,8 @@ class Ros2StandardTopics {
 
   /// Snapshots dropped because the publishing thread was behind by a whole ring.
   std::uint64_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
+  /// Readers matched by the writers of all outputs, summed.
+  std::uint32_t matched_readers() const;
   /// Messages written so far, per output (joint_states, tf, external_wrench).
   std::array<std::uint64_t, 3> written() const;
 

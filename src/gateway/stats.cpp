@@ -27,6 +27,7 @@ std::string to_json(const GatewayStats& stats) {
       {"rejected_source", stats.ingress.rejected_source},
       {"state_readers", stats.state_readers},
       {"egress_writers", stats.egress_writers},
+      {"standard_readers", stats.standard_readers},
       {"lost", stats.sequence.lost},
       {"duplicated", stats.sequence.duplicated},
       {"reordered", stats.sequence.reordered},

@@ -45,6 +45,9 @@ struct GatewayStats {
   IngressCounters ingress;
   std::uint32_t state_readers = 0;   ///< readers matched by the RobotState writer
   std::uint32_t egress_writers = 0;  ///< writers matched by the egress reader
+  /// Readers matched by the ROS 2 standard topics' writers (joint_states, tf, external_wrench),
+  /// summed: the writers' side of discovery, which a test waits for before the robot sends.
+  std::uint32_t standard_readers = 0;
   SequenceTracker::Counts sequence;
   EgressCounters egress;
   /// Snapshots for the ROS 2 standard topics dropped because their publishing thread was a whole

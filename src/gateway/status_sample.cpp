@@ -37,6 +37,7 @@ void to_status_sample(const GatewayStats& stats, GatewayStatus& sample) {
   sample.robot_restarts(stats.sequence.restarts);
   sample.state_readers(stats.state_readers);
   sample.egress_writers(stats.egress_writers);
+  sample.standard_readers(stats.standard_readers);
   sample.egress_samples(stats.egress.samples);
   sample.egress_frames_sent(stats.egress.frames_sent);
   sample.egress_unencodable(stats.egress.unencodable);
@@ -60,6 +61,7 @@ GatewayStats from_status_sample(const GatewayStatus& sample) {
                     .restarts = sample.robot_restarts()};
   stats.state_readers = sample.state_readers();
   stats.egress_writers = sample.egress_writers();
+  stats.standard_readers = sample.standard_readers();
   stats.egress = {.samples = sample.egress_samples(),
                   .frames_sent = sample.egress_frames_sent(),
                   .unencodable = sample.egress_unencodable(),

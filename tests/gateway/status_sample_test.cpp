@@ -20,6 +20,7 @@ GatewayStats distinct_stats() {
   stats.sequence = {.lost = 5, .duplicated = 6, .reordered = 7, .restarts = 8};
   stats.state_readers = 13;
   stats.egress_writers = 14;
+  stats.standard_readers = 16;
   stats.egress = {.samples = 9, .frames_sent = 10, .unencodable = 11, .send_failed = 12};
   stats.standard_dropped = 15;
   return stats;
@@ -56,6 +57,7 @@ TEST(StatusSample, CountersAndLinkStateAreCopied) {
   EXPECT_EQ(sample.robot_restarts(), 8U);
   EXPECT_EQ(sample.state_readers(), 13U);
   EXPECT_EQ(sample.egress_writers(), 14U);
+  EXPECT_EQ(sample.standard_readers(), 16U);
   EXPECT_EQ(sample.egress_samples(), 9U);
   EXPECT_EQ(sample.egress_frames_sent(), 10U);
   EXPECT_EQ(sample.egress_unencodable(), 11U);

@@ -107,6 +107,8 @@ def ros2_namespace_run(h):
     # rclcpp's sensor_data preset (best effort) matches the writers too: it gets at least one message.
     best_effort = start_readers(h, "ros2_sensor_data", {"joint_states": topics["joint_states"]}, {"joint_states": 1},
                                 ["sensor_data"])
+    # The readers' "matched" is their side of discovery; the writers count them once theirs is done.
+    wait_for_stats(stats, lambda s: s["standard_readers"] >= 4, "the standard topics' writers to match 4 readers")
 
     record = h.dir / "ros2.sim.jsonl"
     started = time.time()
@@ -215,6 +217,7 @@ def plain_dds_run(h):
     topics = {"joint_states": "joint_states", "tf": "tf", "wrench": "external_wrench"}
     readers = start_readers(h, "plain", topics,
                             {"joint_states": len(with_joints), "tf": len(frames), "wrench": len(frames)})
+    wait_for_stats(stats, lambda s: s["standard_readers"] >= 3, "the standard topics' writers to match 3 readers")
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as robot:
         for datagram in datagrams:
             robot.sendto(datagram, ("127.0.0.1", port))
