@@ -75,10 +75,61 @@ inline constexpr ReturnCode kOk = eprosima::fastdds::dds::RETCODE_OK;
 inline const Duration kInfinite = eprosima::fastdds::dds::c_TimeInfinite;
 using DiscoveryProtocol = rtps::DiscoveryProtocol;
 
-/// Gives `type` another registered name (the ROS 2 mangled name, a user's --type-name); DDS-SQL
-/// filters on it still find the type's TypeObject (Fast DDS 3 keeps it by type identifier).
+namespace detail {
+
+/// `original` under another name, announcing no TypeInformation: see rename_type().
+class RenamedType final : public eprosima::fastdds::dds::TopicDataType {
+ public:
+  RenamedType(eprosima::fastdds::dds::TypeSupport original, const std::string& name)
+      : original_(std::move(original)) {
+    set_name(name);
+    max_serialized_type_size = original_->max_serialized_type_size;
+    is_compute_key_provided = original_->is_compute_key_provided;
+  }
+
+  bool serialize(const void* const data, rtps::SerializedPayload_t& payload,
+                 eprosima::fastdds::dds::DataRepresentationId_t representation) override {
+    return original_->serialize(data, payload, representation);
+  }
+  bool deserialize(rtps::SerializedPayload_t& payload, void* data) override {
+    return original_->deserialize(payload, data);
+  }
+  std::uint32_t calculate_serialized_size(
+      const void* const data, eprosima::fastdds::dds::DataRepresentationId_t representation) override {
+    return original_->calculate_serialized_size(data, representation);
+  }
+  void* create_data() override { return original_->create_data(); }
+  void delete_data(void* data) override { original_->delete_data(data); }
+  bool compute_key(rtps::SerializedPayload_t& payload, rtps::InstanceHandle_t& handle,
+                   bool force_md5) override {
+    return original_->compute_key(payload, handle, force_md5);
+  }
+  bool compute_key(const void* const data, rtps::InstanceHandle_t& handle, bool force_md5) override {
+    return original_->compute_key(data, handle, force_md5);
+  }
+  bool is_bounded() const override { return original_->is_bounded(); }
+  bool is_plain(eprosima::fastdds::dds::DataRepresentationId_t representation) const override {
+    return original_->is_plain(representation);
+  }
+  bool construct_sample(void* memory) const override { return original_->construct_sample(memory); }
+  /// The original's TypeObject goes into the registry under its own name; this type keeps no type
+  /// identifiers, so its endpoints announce no TypeInformation.
+  void register_type_object_representation() override { original_->register_type_object_representation(); }
+
+ private:
+  eprosima::fastdds::dds::TypeSupport original_;
+};
+
+}  // namespace detail
+
+/// Gives `type` another registered name (the ROS 2 mangled name, a user's --type-name), under which
+/// its endpoints match by type name alone, as on Fast DDS 2: they announce no TypeInformation. The
+/// name belongs to a type defined elsewhere (rosidl's rsg_msgs/msg/RobotState) whose TypeObject
+/// differs from the IDL's (its members are the .msg's lower-case names), and Fast DDS 3 matches two
+/// endpoints that both announce TypeInformation only when their type identifiers are equal: an rclpy
+/// subscription would never match. The samples are the same bytes.
 inline void rename_type(eprosima::fastdds::dds::TypeSupport& type, const std::string& name) {
-  type->set_name(name);
+  type = eprosima::fastdds::dds::TypeSupport(new detail::RenamedType(std::move(type), name));
 }
 
 /// Loads an XML profile file written for Fast DDS 2 (rsg's xml_profiles/) or 3. Fast DDS 3 renamed
