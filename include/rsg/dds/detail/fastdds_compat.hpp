@@ -12,7 +12,7 @@
 //   rsg::dds::kOk, Duration, kInfinite   return code and times
 //   rsg::dds::rtps                       the RTPS namespace (GUID_t, Locator_t, IPLocator, ...)
 //   rsg::dds::serialize, deserialize, max_serialized_size, is_plain, rename_type
-//   rsg::dds::succeeded, is_keyed, disable_intraprocess_delivery
+//   rsg::dds::succeeded, is_keyed, disable_intraprocess_delivery, read_plain_samples_in_place
 //   rsg::dds::load_xml_profiles_file
 //   rsg::dds::add_discovery_server, discovery_server_locator, discovery_server_prefix
 //
@@ -32,6 +32,7 @@
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/topic/TopicDataType.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <fstream>
@@ -225,6 +226,21 @@ inline void disable_intraprocess_delivery() {
     throw std::logic_error("disable_intraprocess_delivery: called after a participant was enabled");
 }
 
+/// Has a reader of a plain type take its samples in place (a data-sharing sample as a loan of the
+/// writer's memory), as Fast DDS 2 does, by listing XCDR1 as the representation it reads when its
+/// profile lists none. Fast DDS 3 reads in place only a type that is plain in every representation
+/// the reader accepts, and counts an empty list as both XCDR1 and XCDR2 there
+/// (DataReaderImpl::get_payload_pool), although for matching an empty list means XCDR1 alone
+/// (EDP::checkDataRepresentationQos): rsg's types are plain in XCDR1 only, so every sample was
+/// deserialized into a copy, and DataReader::is_sample_valid(), which takes the sample for a loan
+/// of the writer's memory and looks for the sequence number in front of it, judged every such copy
+/// from a data-sharing writer overwritten (eProsima/Fast-DDS#2609): rsg_echo dropped them all. The
+/// reader still matches the same writers.
+inline void read_plain_samples_in_place(eprosima::fastdds::dds::DataReaderQos& qos) {
+  auto& representations = qos.representation().m_value;
+  if (representations.empty()) representations.push_back(eprosima::fastdds::dds::XCDR_DATA_REPRESENTATION);
+}
+
 /// Adds the discovery server number `id` at `locator` (Fast DDS 3 needs no server GUID prefix).
 inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& qos, unsigned /*id*/,
                                  const rtps::Locator_t& locator) {
@@ -303,6 +319,9 @@ inline void disable_intraprocess_delivery() {
   settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
   eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
 }
+
+/// Fast DDS 2 reads a plain type in place whatever the reader's representations.
+inline void read_plain_samples_in_place(eprosima::fastdds::dds::DataReaderQos& /*qos*/) {}
 
 /// Fast DDS 2 finds server number `id` by its default GUID prefix.
 inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& qos, unsigned id,
