@@ -21,11 +21,9 @@ build=${RSG_FASTDDS3_BUILD:-build-fdds3}
 jobs=${JOBS:-$(nproc)}
 chroot=tools/fastdds3/chroot.sh
 logs=$build/test-fastdds3
-# The integration tests that also run against 3.x: the pipeline, its errors and selections.
-# Not late_joiner: on 3.1.2 a same-host TRANSIENT_LOCAL reader with data-sharing (Fast DDS's default,
-# AUTO) that matches after the gateway stopped writing gets none of the retained history; with
-# data-sharing OFF the same test passes (docs/fastdds-versions.md).
-integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors"
+# The integration tests that also run against 3.x: the pipeline, its errors and selections, and a
+# data-sharing reader's history (late_joiner).
+integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors|late_joiner"
 targets=(unit_tests rsg_gateway rsg_sim rsg_echo rsg_frame rsg_status_probe rsg_views_publish rsg_view
          rsg_cyclone_echo rsg_cyclone_publish)
 
@@ -101,10 +99,12 @@ else
   check sim_to_echo_3_gateway_2.9_echo python3 tests/integration/test_sim_to_echo.py --bin "$gateway3"
   check sim_to_echo_2.9_gateway_3_echo python3 tests/integration/test_sim_to_echo.py --bin "$echo3"
   # ROS 2: rclpy nodes (rmw_fastrtps_cpp, Fast DDS 3.2 from the Kilted wheels of `make deps`, on the
-  # host) reading a 3.1.2 gateway's --ros2 topics.
+  # host) and a 3.1.2 gateway: its --ros2 topics, the standard ones, egress, node churn.
   deps=$(sed -n 's/^RSG_DEPS_DIR:PATH=//p' "$host_build/CMakeCache.txt")
-  check ros2_rclpy_state_3_gateway env RSG_DEPS_DIR="${deps:-$checkout/.deps}" \
-    python3 tests/ros2/test_rclpy_state.py --bin "$gateway3"
+  for test in state standard egress churn; do
+    check ros2_rclpy_${test}_3_gateway env RSG_DEPS_DIR="${deps:-$checkout/.deps}" \
+      python3 tests/ros2/test_rclpy_$test.py --bin "$gateway3"
+  done
 fi
 echo "test-fastdds3: $((SECONDS - start)) s"
 echo "test-fastdds3: $passed passed, $failed failed"
