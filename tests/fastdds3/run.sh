@@ -21,11 +21,18 @@ build=${RSG_FASTDDS3_BUILD:-build-fdds3}
 jobs=${JOBS:-$(nproc)}
 chroot=tools/fastdds3/chroot.sh
 logs=$build/test-fastdds3
-# The integration tests that also run against 3.x: the pipeline, its errors and selections, and a
-# data-sharing reader's history (late_joiner).
+# The process tests that also run against 3.x: the pipeline, its errors and selections, a
+# data-sharing reader's history (late_joiner), rate topics, the demo, the embedded gateway, the
+# standard ROS 2 topics read by Cyclone, the CLI. Not the ones that need tshark or Node (pcap_replay,
+# replay_formats, flight_recorder; record.*, view.*), nor Debian's rosidl (ros2.rosidl_cyclone,
+# ros2.egress): the chroot has none of them.
 integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors|late_joiner"
+integration+="|rate_topic|demo|realtime_gateway|embedded_controller"
+processes="views\.rsg_echo|interop\.cyclone|integration\.($integration)|ros2\.(standard_topics|msg_matches_field_table)"
+processes+="|gateway\.embedded|cli\.rsg_frame"
 targets=(unit_tests rsg_gateway rsg_sim rsg_echo rsg_frame rsg_status_probe rsg_views_publish rsg_view
-         rsg_cyclone_echo rsg_cyclone_publish)
+         rsg_cyclone_echo rsg_cyclone_publish rsg_example_embedded_controller rsg_ros2_standard_echo
+         rsg_generate_msg)
 
 passed=0
 failed=0
@@ -66,7 +73,7 @@ echo "test-fastdds3: built in the chroot in $((SECONDS - start)) s"
 # above are built).
 $chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -L unit -E '^(IngressAllocation\..*|packaging)\$'" 2>&1 | tee "$logs/unit.log" | tail -n 3
 count_ctest "$logs/unit.log"
-$chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -R '^(views\.rsg_echo|interop\.cyclone|integration\.($integration))\$'" \
+$chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -R '^($processes)\$'" \
   2>&1 | tee "$logs/processes.log" | grep -E '^ *[0-9]+/[0-9]+ Test|tests passed'
 count_ctest "$logs/processes.log"
 
