@@ -48,6 +48,7 @@
 #include <fastdds/config.hpp>
 #include <fastdds/dds/core/ReturnCode.hpp>
 #include <fastdds/dds/core/Time_t.hpp>
+#include <fastdds/dds/xtypes/type_representation/TypeObject.hpp>
 #include <fastdds/rtps/attributes/PropertyPolicy.hpp>
 #include <fastdds/rtps/common/SerializedPayload.hpp>
 #include <fastdds/utils/IPLocator.hpp>
@@ -113,9 +114,24 @@ class RenamedType final : public eprosima::fastdds::dds::TopicDataType {
     return original_->is_plain(representation);
   }
   bool construct_sample(void* memory) const override { return original_->construct_sample(memory); }
-  /// The original's TypeObject goes into the registry under its own name; this type keeps no type
-  /// identifiers, so its endpoints announce no TypeInformation.
-  void register_type_object_representation() override { original_->register_type_object_representation(); }
+  /// The original's TypeObject goes into the registry under its own name and, for the DDS-SQL filter
+  /// factory (which looks it up by the topic's type name), under this one, unless that name is taken
+  /// (in a ROS 2 process by rosidl's type, in which filters find the same members by the same bytes).
+  /// This type keeps no type identifiers, so its endpoints announce no TypeInformation.
+  void register_type_object_representation() override {
+    namespace xtypes = eprosima::fastdds::dds::xtypes;
+    original_->register_type_object_representation();
+    auto& registry = eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->type_object_registry();
+    xtypes::TypeIdentifierPair ids;
+    if (registry.get_type_identifiers(get_name(), ids) == kOk) return;
+    const xtypes::TypeIdentifierPair& original = original_->type_identifiers();
+    const xtypes::TypeIdentifier& complete = original.type_identifier1()._d() == xtypes::EK_COMPLETE
+                                                 ? original.type_identifier1()
+                                                 : original.type_identifier2();
+    xtypes::TypeObject object;
+    if (registry.get_type_object(complete, object) == kOk && object._d() == xtypes::EK_COMPLETE)
+      registry.register_type_object(get_name(), object.complete(), ids);
+  }
 
  private:
   eprosima::fastdds::dds::TypeSupport original_;
@@ -128,7 +144,8 @@ class RenamedType final : public eprosima::fastdds::dds::TopicDataType {
 /// name belongs to a type defined elsewhere (rosidl's rsg_msgs/msg/RobotState) whose TypeObject
 /// differs from the IDL's (its members are the .msg's lower-case names), and Fast DDS 3 matches two
 /// endpoints that both announce TypeInformation only when their type identifiers are equal: an rclpy
-/// subscription would never match. The samples are the same bytes.
+/// subscription would never match. The samples are the same bytes, and DDS-SQL filters on the new
+/// name read the original's members.
 inline void rename_type(eprosima::fastdds::dds::TypeSupport& type, const std::string& name) {
   type = eprosima::fastdds::dds::TypeSupport(new detail::RenamedType(std::move(type), name));
 }
