@@ -97,6 +97,7 @@ else
   gateway3=$(mixed gateway3 rsg_gateway)
   echo3=$(mixed echo3 rsg_echo rsg_status_probe)
   publish3=$(mixed publish3 rsg_views_publish)
+  gateway_echo3=$(mixed gateway_echo3 rsg_gateway rsg_echo)
   # Views, content filters included: 3.x readers on a 2.9 writer's stream, and 2.9 readers on 3.x's.
   check views_2.9_writer_3_readers python3 tests/dds_views/echo_views_test.py --echo "$echo3/rsg_echo" \
     --publish "$host_build/bin/rsg_views_publish" -v
@@ -105,6 +106,17 @@ else
   # The pipeline: a 3.x gateway read by 2.9's rsg_echo, a 2.9 gateway read by 3.x's, values exact.
   check sim_to_echo_3_gateway_2.9_echo python3 tests/integration/test_sim_to_echo.py --bin "$gateway3"
   check sim_to_echo_2.9_gateway_3_echo python3 tests/integration/test_sim_to_echo.py --bin "$echo3"
+  # ROS 2 types from ROS's own tools (rosidl -> IDL -> Cyclone, built on the host) and a 3.1.2 gateway:
+  # its --ros2 topics read, a view on them (rsg_echo --ros2 --view, 3.1.2), egress from a ROS publisher.
+  if [[ -x $host_build/bin/rsg_ros2_cyclone_echo ]]; then
+    for test in gateway egress; do
+      check ros2_rosidl_cyclone_${test}_3 env RSG_ROS2_ECHO="$checkout/$host_build/bin/rsg_ros2_cyclone_echo" \
+        python3 tests/ros2/test_ros2_$test.py --bin "$gateway_echo3"
+    done
+  else
+    echo "test-fastdds3: no rsg_ros2_cyclone_echo in $host_build (Debian's rosidl and Cyclone): not run" >&2
+    failed=$((failed + 1))
+  fi
   # ROS 2: rclpy nodes (rmw_fastrtps_cpp, Fast DDS 3.2 from the Kilted wheels of `make deps`, on the
   # host) and a 3.1.2 gateway: its --ros2 topics, the standard ones, egress, node churn.
   deps=$(sed -n 's/^RSG_DEPS_DIR:PATH=//p' "$host_build/CMakeCache.txt")
