@@ -25,7 +25,7 @@ logs=$build/test-fastdds3
 # data-sharing reader's history (late_joiner), rate topics, the demo, the embedded gateway, the
 # standard ROS 2 topics read by Cyclone, the CLI. Not the ones that need tshark or Node (pcap_replay,
 # replay_formats, flight_recorder; record.*, view.*), nor Debian's rosidl (ros2.rosidl_cyclone,
-# ros2.egress): the chroot has none of them.
+# ros2.egress: run across below): the chroot has none of them.
 integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors|late_joiner"
 integration+="|rate_topic|demo|realtime_gateway|embedded_controller"
 processes="views\.rsg_echo|interop\.cyclone|integration\.($integration)|ros2\.(standard_topics|msg_matches_field_table)"
