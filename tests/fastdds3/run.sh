@@ -21,13 +21,18 @@ build=${RSG_FASTDDS3_BUILD:-build-fdds3}
 jobs=${JOBS:-$(nproc)}
 chroot=tools/fastdds3/chroot.sh
 logs=$build/test-fastdds3
-# The integration tests that also run against 3.x: the pipeline, its errors and selections.
-# Not late_joiner: on 3.1.2 a same-host TRANSIENT_LOCAL reader with data-sharing (Fast DDS's default,
-# AUTO) that matches after the gateway stopped writing gets none of the retained history; with
-# data-sharing OFF the same test passes (docs/fastdds-versions.md).
-integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors"
+# The process tests that also run against 3.x: the pipeline, its errors and selections, a
+# data-sharing reader's history (late_joiner), rate topics, the demo, the embedded gateway, the
+# standard ROS 2 topics read by Cyclone, the CLI. Not the ones that need tshark or Node (pcap_replay,
+# replay_formats, flight_recorder; record.*, view.*), nor Debian's rosidl (ros2.rosidl_cyclone,
+# ros2.egress: run across below): the chroot has none of them.
+integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors|late_joiner"
+integration+="|rate_topic|demo|realtime_gateway|embedded_controller"
+processes="views\.rsg_echo|interop\.cyclone|integration\.($integration)|ros2\.(standard_topics|msg_matches_field_table)"
+processes+="|gateway\.embedded|cli\.rsg_frame"
 targets=(unit_tests rsg_gateway rsg_sim rsg_echo rsg_frame rsg_status_probe rsg_views_publish rsg_view
-         rsg_cyclone_echo rsg_cyclone_publish)
+         rsg_cyclone_echo rsg_cyclone_publish rsg_example_embedded_controller rsg_ros2_standard_echo
+         rsg_generate_msg)
 
 passed=0
 failed=0
@@ -51,7 +56,12 @@ check() {  # NAME COMMAND...: one cross-version test, its output in $logs/NAME.l
 
 start=$SECONDS
 $chroot setup || exit 1
+# The chroot has no ROS 2 environment: the gateway announces the RIHS01 type hashes the host build
+# had rosidl compute (cmake/rsg_ros2_type_hashes.cmake), which the rclpy cross test checks.
+hashes=$checkout/$host_build/generated/rsg_ros2_type_hashes.hpp
+grep -qs "kTypeHashesKnown = true" "$hashes" || hashes=
 $chroot in cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRSG_FASTDDS=3 \
+  -DRSG_ROS2_TYPE_HASHES_FROM="$hashes" \
   -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache > /dev/null || exit 1
 $chroot in cmake --build "$build" -j "$jobs" --target "${targets[@]}" || exit 1
 mkdir -p "$logs"
@@ -63,7 +73,7 @@ echo "test-fastdds3: built in the chroot in $((SECONDS - start)) s"
 # above are built).
 $chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -L unit -E '^(IngressAllocation\..*|packaging)\$'" 2>&1 | tee "$logs/unit.log" | tail -n 3
 count_ctest "$logs/unit.log"
-$chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -R '^(views\.rsg_echo|interop\.cyclone|integration\.($integration))\$'" \
+$chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -R '^($processes)\$'" \
   2>&1 | tee "$logs/processes.log" | grep -E '^ *[0-9]+/[0-9]+ Test|tests passed'
 count_ctest "$logs/processes.log"
 
@@ -87,6 +97,7 @@ else
   gateway3=$(mixed gateway3 rsg_gateway)
   echo3=$(mixed echo3 rsg_echo rsg_status_probe)
   publish3=$(mixed publish3 rsg_views_publish)
+  gateway_echo3=$(mixed gateway_echo3 rsg_gateway rsg_echo)
   # Views, content filters included: 3.x readers on a 2.9 writer's stream, and 2.9 readers on 3.x's.
   check views_2.9_writer_3_readers python3 tests/dds_views/echo_views_test.py --echo "$echo3/rsg_echo" \
     --publish "$host_build/bin/rsg_views_publish" -v
@@ -95,16 +106,24 @@ else
   # The pipeline: a 3.x gateway read by 2.9's rsg_echo, a 2.9 gateway read by 3.x's, values exact.
   check sim_to_echo_3_gateway_2.9_echo python3 tests/integration/test_sim_to_echo.py --bin "$gateway3"
   check sim_to_echo_2.9_gateway_3_echo python3 tests/integration/test_sim_to_echo.py --bin "$echo3"
-  # ROS 2: rclpy nodes (rmw_fastrtps_cpp, Fast DDS 3.2 from the Kilted wheels of `make deps`, on the
-  # host) reading a 3.1.2 gateway's --ros2 topics. They do not match yet (docs/fastdds-versions.md,
-  # Findings): run it with RSG_FASTDDS3_ROS2=1 while that is open, so that CI stays a signal.
-  if [[ ${RSG_FASTDDS3_ROS2:-0} == 1 ]]; then
-    deps=$(sed -n 's/^RSG_DEPS_DIR:PATH=//p' "$host_build/CMakeCache.txt")
-    check ros2_rclpy_state_3_gateway env RSG_DEPS_DIR="${deps:-$checkout/.deps}" \
-      python3 tests/ros2/test_rclpy_state.py --bin "$gateway3"
+  # ROS 2 types from ROS's own tools (rosidl -> IDL -> Cyclone, built on the host) and a 3.1.2 gateway:
+  # its --ros2 topics read, a view on them (rsg_echo --ros2 --view, 3.1.2), egress from a ROS publisher.
+  if [[ -x $host_build/bin/rsg_ros2_cyclone_echo ]]; then
+    for test in gateway egress; do
+      check ros2_rosidl_cyclone_${test}_3 env RSG_ROS2_ECHO="$checkout/$host_build/bin/rsg_ros2_cyclone_echo" \
+        python3 tests/ros2/test_ros2_$test.py --bin "$gateway_echo3"
+    done
   else
-    echo "cross.ros2_rclpy_state_3_gateway: not run (open: rclpy does not match a 3.x gateway; RSG_FASTDDS3_ROS2=1 runs it)"
+    echo "test-fastdds3: no rsg_ros2_cyclone_echo in $host_build (Debian's rosidl and Cyclone): not run" >&2
+    failed=$((failed + 1))
   fi
+  # ROS 2: rclpy nodes (rmw_fastrtps_cpp, Fast DDS 3.2 from the Kilted wheels of `make deps`, on the
+  # host) and a 3.1.2 gateway: its --ros2 topics, the standard ones, egress, node churn.
+  deps=$(sed -n 's/^RSG_DEPS_DIR:PATH=//p' "$host_build/CMakeCache.txt")
+  for test in state standard egress churn; do
+    check ros2_rclpy_${test}_3_gateway env RSG_DEPS_DIR="${deps:-$checkout/.deps}" \
+      python3 tests/ros2/test_rclpy_$test.py --bin "$gateway3"
+  done
 fi
 echo "test-fastdds3: $((SECONDS - start)) s"
 echo "test-fastdds3: $passed passed, $failed failed"

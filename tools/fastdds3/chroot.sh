@@ -87,11 +87,15 @@ in_chroot() {
     return
   fi
   # In the background so that the trap can pass SIGTERM and SIGINT on (a test stopping its child)
-  # and still unmount after; stdin stays the caller's.
-  chroot "$root" /usr/bin/env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
+  # and still unmount after; stdin stays the caller's. A SIGKILL cannot be passed on (a test harness
+  # killing its children on failure): the kernel sends CMD SIGTERM when this shell dies (setpriv's
+  # parent-death signal, kept across chroot's, env's and sh's exec; the subshell execs, so that the
+  # parent is this shell, not a copy of it).
+  (exec setpriv --pdeathsig TERM chroot "$root" /usr/bin/env -i HOME=/root \
+    PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
     LANG=C.UTF-8 CCACHE_DIR="${CCACHE_DIR:-$checkout/.cache/ccache-trixie}" CCACHE_BASEDIR="$checkout" \
     CCACHE_NOHASHDIR=true ${CI:+CI=$CI} ${RSG_CHROOT_ENV:-} \
-    sh -c 'cd "$0" 2>/dev/null || cd /; exec "$@"' "$PWD" "$@" <&0 &
+    sh -c 'cd "$0" 2>/dev/null || cd /; exec "$@"' "$PWD" "$@") <&0 &
   child=$!
   trap 'kill -TERM $child 2>/dev/null' TERM
   trap 'kill -INT $child 2>/dev/null' INT

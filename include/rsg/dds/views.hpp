@@ -71,7 +71,8 @@ View parse_view(const std::string& profile, const eprosima::fastdds::dds::DataRe
 /// @throws ViewError for an unknown or unusable profile.
 View load_view(const eprosima::fastdds::dds::Subscriber& subscriber, const std::string& profile);
 
-/// Reads an XML data_reader profile's QoS.
+/// Reads an XML data_reader profile's QoS, with which a reader takes plain samples in place on
+/// either Fast DDS (read_plain_samples_in_place()).
 /// @throws ViewError naming an unknown profile.
 eprosima::fastdds::dds::DataReaderQos load_reader_qos(const eprosima::fastdds::dds::Subscriber& subscriber,
                                                       const std::string& profile);

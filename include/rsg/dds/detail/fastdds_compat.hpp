@@ -12,7 +12,7 @@
 //   rsg::dds::kOk, Duration, kInfinite   return code and times
 //   rsg::dds::rtps                       the RTPS namespace (GUID_t, Locator_t, IPLocator, ...)
 //   rsg::dds::serialize, deserialize, max_serialized_size, is_plain, rename_type
-//   rsg::dds::succeeded, is_keyed, disable_intraprocess_delivery
+//   rsg::dds::succeeded, is_keyed, disable_intraprocess_delivery, read_plain_samples_in_place
 //   rsg::dds::load_xml_profiles_file
 //   rsg::dds::add_discovery_server, discovery_server_locator, discovery_server_prefix
 //
@@ -32,6 +32,7 @@
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/topic/TopicDataType.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <fstream>
@@ -47,6 +48,7 @@
 #include <fastdds/config.hpp>
 #include <fastdds/dds/core/ReturnCode.hpp>
 #include <fastdds/dds/core/Time_t.hpp>
+#include <fastdds/dds/xtypes/type_representation/TypeObject.hpp>
 #include <fastdds/rtps/attributes/PropertyPolicy.hpp>
 #include <fastdds/rtps/common/SerializedPayload.hpp>
 #include <fastdds/utils/IPLocator.hpp>
@@ -75,10 +77,77 @@ inline constexpr ReturnCode kOk = eprosima::fastdds::dds::RETCODE_OK;
 inline const Duration kInfinite = eprosima::fastdds::dds::c_TimeInfinite;
 using DiscoveryProtocol = rtps::DiscoveryProtocol;
 
-/// Gives `type` another registered name (the ROS 2 mangled name, a user's --type-name); DDS-SQL
-/// filters on it still find the type's TypeObject (Fast DDS 3 keeps it by type identifier).
+namespace detail {
+
+/// `original` under another name, announcing no TypeInformation: see rename_type().
+class RenamedType final : public eprosima::fastdds::dds::TopicDataType {
+ public:
+  RenamedType(eprosima::fastdds::dds::TypeSupport original, const std::string& name)
+      : original_(std::move(original)) {
+    set_name(name);
+    max_serialized_type_size = original_->max_serialized_type_size;
+    is_compute_key_provided = original_->is_compute_key_provided;
+  }
+
+  bool serialize(const void* const data, rtps::SerializedPayload_t& payload,
+                 eprosima::fastdds::dds::DataRepresentationId_t representation) override {
+    return original_->serialize(data, payload, representation);
+  }
+  bool deserialize(rtps::SerializedPayload_t& payload, void* data) override {
+    return original_->deserialize(payload, data);
+  }
+  std::uint32_t calculate_serialized_size(
+      const void* const data, eprosima::fastdds::dds::DataRepresentationId_t representation) override {
+    return original_->calculate_serialized_size(data, representation);
+  }
+  void* create_data() override { return original_->create_data(); }
+  void delete_data(void* data) override { original_->delete_data(data); }
+  bool compute_key(rtps::SerializedPayload_t& payload, rtps::InstanceHandle_t& handle,
+                   bool force_md5) override {
+    return original_->compute_key(payload, handle, force_md5);
+  }
+  bool compute_key(const void* const data, rtps::InstanceHandle_t& handle, bool force_md5) override {
+    return original_->compute_key(data, handle, force_md5);
+  }
+  bool is_bounded() const override { return original_->is_bounded(); }
+  bool is_plain(eprosima::fastdds::dds::DataRepresentationId_t representation) const override {
+    return original_->is_plain(representation);
+  }
+  bool construct_sample(void* memory) const override { return original_->construct_sample(memory); }
+  /// The original's TypeObject goes into the registry under its own name and, for the DDS-SQL filter
+  /// factory (which looks it up by the topic's type name), under this one, unless that name is taken
+  /// (in a ROS 2 process by rosidl's type, in which filters find the same members by the same bytes).
+  /// This type keeps no type identifiers, so its endpoints announce no TypeInformation.
+  void register_type_object_representation() override {
+    namespace xtypes = eprosima::fastdds::dds::xtypes;
+    original_->register_type_object_representation();
+    auto& registry = eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->type_object_registry();
+    xtypes::TypeIdentifierPair ids;
+    if (registry.get_type_identifiers(get_name(), ids) == kOk) return;
+    const xtypes::TypeIdentifierPair& original = original_->type_identifiers();
+    const xtypes::TypeIdentifier& complete = original.type_identifier1()._d() == xtypes::EK_COMPLETE
+                                                 ? original.type_identifier1()
+                                                 : original.type_identifier2();
+    xtypes::TypeObject object;
+    if (registry.get_type_object(complete, object) == kOk && object._d() == xtypes::EK_COMPLETE)
+      registry.register_type_object(get_name(), object.complete(), ids);
+  }
+
+ private:
+  eprosima::fastdds::dds::TypeSupport original_;
+};
+
+}  // namespace detail
+
+/// Gives `type` another registered name (the ROS 2 mangled name, a user's --type-name), under which
+/// its endpoints match by type name alone, as on Fast DDS 2: they announce no TypeInformation. The
+/// name belongs to a type defined elsewhere (rosidl's rsg_msgs/msg/RobotState) whose TypeObject
+/// differs from the IDL's (its members are the .msg's lower-case names), and Fast DDS 3 matches two
+/// endpoints that both announce TypeInformation only when their type identifiers are equal: an rclpy
+/// subscription would never match. The samples are the same bytes, and DDS-SQL filters on the new
+/// name read the original's members.
 inline void rename_type(eprosima::fastdds::dds::TypeSupport& type, const std::string& name) {
-  type->set_name(name);
+  type = eprosima::fastdds::dds::TypeSupport(new detail::RenamedType(std::move(type), name));
 }
 
 /// Loads an XML profile file written for Fast DDS 2 (rsg's xml_profiles/) or 3. Fast DDS 3 renamed
@@ -174,6 +243,21 @@ inline void disable_intraprocess_delivery() {
     throw std::logic_error("disable_intraprocess_delivery: called after a participant was enabled");
 }
 
+/// Has a reader of a plain type take its samples in place (a data-sharing sample as a loan of the
+/// writer's memory), as Fast DDS 2 does, by listing XCDR1 as the representation it reads when its
+/// profile lists none. Fast DDS 3 reads in place only a type that is plain in every representation
+/// the reader accepts, and counts an empty list as both XCDR1 and XCDR2 there
+/// (DataReaderImpl::get_payload_pool), although for matching an empty list means XCDR1 alone
+/// (EDP::checkDataRepresentationQos): rsg's types are plain in XCDR1 only, so every sample was
+/// deserialized into a copy, and DataReader::is_sample_valid(), which takes the sample for a loan
+/// of the writer's memory and looks for the sequence number in front of it, judged every such copy
+/// from a data-sharing writer overwritten (eProsima/Fast-DDS#2609): rsg_echo dropped them all. The
+/// reader still matches the same writers.
+inline void read_plain_samples_in_place(eprosima::fastdds::dds::DataReaderQos& qos) {
+  auto& representations = qos.representation().m_value;
+  if (representations.empty()) representations.push_back(eprosima::fastdds::dds::XCDR_DATA_REPRESENTATION);
+}
+
 /// Adds the discovery server number `id` at `locator` (Fast DDS 3 needs no server GUID prefix).
 inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& qos, unsigned /*id*/,
                                  const rtps::Locator_t& locator) {
@@ -252,6 +336,9 @@ inline void disable_intraprocess_delivery() {
   settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
   eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
 }
+
+/// Fast DDS 2 reads a plain type in place whatever the reader's representations.
+inline void read_plain_samples_in_place(eprosima::fastdds::dds::DataReaderQos& /*qos*/) {}
 
 /// Fast DDS 2 finds server number `id` by its default GUID prefix.
 inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& qos, unsigned id,
