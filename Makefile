@@ -118,9 +118,13 @@ clean:
 
 # Fast DDS 3 (Debian 13's 3.1.2) in a cached trixie chroot, and across versions with $(BUILD)'s
 # 2.9.1 on the host (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/.
-.PHONY: test-fastdds3
+.PHONY: test-fastdds3 bench-fastdds3
 test-fastdds3: build
 	JOBS=$(JOBS) tests/fastdds3/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds3.log
+
+# make bench's e2e suite on 2.9 (host) and 3.x (chroot) back to back, side by side (docs/benchmarks/fastdds3/).
+bench-fastdds3: build
+	JOBS=$(JOBS) tests/fastdds3/bench.sh $(BUILD)
 
 # The container image (docs/container.md) with the engine that works here: Docker when `docker info`
 # answers, else podman with docker/containers.conf (docker/engine.sh). IMAGE names it.

@@ -76,6 +76,15 @@ def command_output(*command):
         return "?"
 
 
+def fastdds_version():
+    """The installed Fast DDS library package's version: libfastrtps2.x (Debian 12) or libfastdds3.x."""
+    for pattern in ("libfastrtps2*", "libfastdds3*"):
+        for line in command_output("dpkg-query", "-W", "-f=${Version}\\n", pattern).splitlines():
+            if line and line != "?":
+                return line
+    return "?"
+
+
 def machine():
     lscpu = {}
     for line in command_output("lscpu").splitlines():
@@ -86,7 +95,7 @@ def machine():
         "cpus": os.cpu_count(),
         "hypervisor": lscpu.get("Hypervisor vendor", "none"),
         "kernel": platform.release(),
-        "fastdds": command_output("dpkg-query", "-W", "-f=${Version}", "libfastrtps2.9"),
+        "fastdds": fastdds_version(),
         "cyclonedds": command_output("dpkg-query", "-W", "-f=${Version}", "cyclonedds-tools"),
     }
 

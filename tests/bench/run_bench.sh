@@ -80,7 +80,8 @@ run_e2e() {
   soak_seconds=${RSG_BENCH_E2E_SOAK_SECONDS:-$soak_seconds}
   rm -rf "$runs" && mkdir -p "$runs"
   local commit
-  commit=$(git -C "$here" describe --always --dirty 2>/dev/null || echo unknown)
+  # RSG_BENCH_COMMIT: where git cannot tell (the Fast DDS 3 chroot has no git).
+  commit=${RSG_BENCH_COMMIT:-$(git -C "$here" describe --always --dirty 2>/dev/null || echo unknown)}
   printf '{"latency_run_s": %s, "max_rate_step_s": %s, "soak_s": %s, "soak_concurrent": %s, "full": %s, "commit": "%s"}\n' \
     "$seconds" "$step_seconds" "$soak_seconds" "$soak_concurrent" "${RSG_BENCH_FULL:-0}" "$commit" >"$runs/settings.json"
 

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# make bench-fastdds3: make bench's e2e suite on Fast DDS 2.9 (the host's build) and then on 3.x
+# (Debian 13's 3.1.2, the chroot's build of tools/fastdds3/chroot.sh), one right after the other on
+# one machine, and the two side by side (tests/bench/compare_fastdds.py). The committed runs and what
+# they say: docs/benchmarks/fastdds3/.
+#
+#   tests/fastdds3/bench.sh [HOST_BUILD]     HOST_BUILD: the host's 2.9 build tree (default build)
+#
+# The RSG_BENCH_E2E_* durations of tests/bench/run_bench.sh apply to both runs.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+host_build=${1:-build}
+build=${RSG_FASTDDS3_BUILD:-build-fdds3}
+chroot=tools/fastdds3/chroot.sh
+targets=(rsg_bench_e2e rsg_bench_relay_cyclone rsg_bench_cyclone_reader)
+
+$chroot setup
+[[ -f $build/CMakeCache.txt ]] ||
+  $chroot in cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRSG_FASTDDS=3 \
+    -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache > /dev/null
+$chroot in cmake --build "$build" -j "${JOBS:-$(nproc)}" --target "${targets[@]}"
+cmake --build "$host_build" -j "${JOBS:-$(nproc)}" --target "${targets[@]}"
+
+tests/bench/run_bench.sh "$host_build" e2e > /dev/null
+# The chroot starts from an empty environment: the durations and the commit (no git in there) go in.
+settings=(RSG_BENCH_COMMIT="$(git describe --always --dirty)")
+for name in RSG_BENCH_FULL RSG_BENCH_E2E_SECONDS RSG_BENCH_E2E_STEP_SECONDS RSG_BENCH_E2E_SOAK_SECONDS; do
+  [[ -n ${!name:-} ]] && settings+=("$name=${!name}")
+done
+$chroot in env "${settings[@]}" tests/bench/run_bench.sh "$build" e2e > /dev/null
+python3 tests/bench/compare_fastdds.py "$host_build/bench/results.json" "$build/bench/results.json" |
+  tee "$build/bench/comparison.md"
