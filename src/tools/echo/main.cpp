@@ -176,7 +176,6 @@ std::optional<rsg::dds::View> requested_view(const Options& options, const fdds:
 }
 
 int run(const Options& options) {
-  StopOnSignal::block_stop_signals();
   rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery);
   const std::string topic_name =
       options.ros2 ? rsg::dds::ros2_topic_name(options.ros2_namespace, options.topic) : options.topic;
@@ -272,6 +271,9 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
   rsg::tools::init_logging("rsg_echo");
+  // Before anything starts a thread (Fast DDS 3 does when the profiles load): a thread that leaves
+  // SIGINT unblocked can take it, and discard it where SIGINT is ignored (a background job).
+  StopOnSignal::block_stop_signals();
   CLI::App app{"Prints the RobotState samples of a topic, or of a group view of it.", "rsg_echo"};
   app.footer(
       "Views: view_poses (group 0), view_load_and_elbow (1), view_joints (2), view_contact (3), "

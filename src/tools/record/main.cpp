@@ -265,7 +265,6 @@ int recover(const Options& options) {
 }
 
 int run(const Options& options, rsg::tools::record::Profile profile) {
-  StopOnSignal::block_stop_signals();
   Recording recording(options, profile);  // before DDS: an unwritable path fails at once
 
   rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery);
@@ -332,6 +331,9 @@ int run(const Options& options, rsg::tools::record::Profile profile) {
 
 int main(int argc, char** argv) {
   rsg::tools::init_logging("rsg_record");
+  // Before anything starts a thread (Fast DDS 3 does when the profiles load): a thread that leaves
+  // SIGINT unblocked can take it, and discard it where SIGINT is ignored (a background job).
+  StopOnSignal::block_stop_signals();
   CLI::App app{"Records RobotState and GatewayStatus samples into an MCAP file.", "rsg_record"};
   app.footer(
       "Exit status: 0 after --duration or on SIGINT/SIGTERM (the file finished), 1 when the file cannot be "

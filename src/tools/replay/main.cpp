@@ -234,7 +234,6 @@ void wait_for_readers(fdds::DataWriter& writer, int readers, const std::atomic<b
 }
 
 int run(const Options& options) {
-  StopOnSignal::block_stop_signals();
   std::atomic<bool> stop = false;
   StopOnSignal stop_on_signal([&stop] { stop = true; });
   const rsg::mcap::MappedFile file(options.file);
@@ -283,6 +282,9 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
   rsg::tools::init_logging("rsg_replay");
+  // Before anything starts a thread (Fast DDS 3 does when the profiles load): a thread that leaves
+  // SIGINT unblocked can take it, and discard it where SIGINT is ignored (a background job).
+  StopOnSignal::block_stop_signals();
   CLI::App app{"Plays an rsg_record MCAP file back as raw frames (--to) or DDS samples (--domain).",
                "rsg_replay"};
   app.footer(

@@ -108,7 +108,6 @@ void split_listen(const std::string& text, rsg::tools::view::ServerOptions& serv
 }
 
 int run(const Options& options) {
-  StopOnSignal::block_stop_signals();
   rsg::tools::view::ChannelSet channels(options.topic, options.status_topic);
   rsg::tools::view::Server server(options.server, channels.channels(), web_files(options));
   spdlog::info("serving ws://{0}:{1} and http://{0}:{1}/", options.server.host, server.port());
@@ -172,6 +171,9 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
   rsg::tools::init_logging("rsg_view");
+  // Before anything starts a thread (Fast DDS 3 does when the profiles load): a thread that leaves
+  // SIGINT unblocked can take it, and discard it where SIGINT is ignored (a background job).
+  StopOnSignal::block_stop_signals();
   CLI::App app{"Serves RobotState and GatewayStatus to Foxglove, PlotJuggler and a live web page.",
                "rsg_view"};
   app.footer(
