@@ -6,9 +6,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+#include <fstream>
+#include <iterator>
 #include <mutex>
 #include <random>
 #include <thread>
@@ -28,9 +31,17 @@ using Bytes = std::vector<std::uint8_t>;
 constexpr std::size_t kFrames = 300;
 constexpr std::size_t kCorruptEvery = 10;
 
-std::string config(int domain, const std::string& topic) {
+std::string config(int domain, const std::string& topic, const std::string& stats_file = {}) {
   return "listen: 127.0.0.1:0\nlog-level: warn\ndomain: " + std::to_string(domain) + "\ntopic: " + topic +
-         "\nstatus-topic: " + topic + "_status\nprofiles: " RSG_PROFILES_DIR "\n";
+         "\nstatus-topic: " + topic + "_status\nprofiles: " RSG_PROFILES_DIR "\n" +
+         (stats_file.empty() ? std::string() : "stats-file: " + stats_file + "\n");
+}
+
+// Whether the gateway's stats file (rewritten once a second) counts `readers` matched state readers.
+bool stats_count_readers(const std::string& stats_file, int readers) {
+  std::ifstream in(stats_file);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return text.find("\"state_readers\":" + std::to_string(readers)) != std::string::npos;
 }
 
 Bytes frame_of(const RobotState& sample) {
@@ -53,10 +64,13 @@ class EmbeddedGatewayTest : public ::testing::Test {
 TEST_F(EmbeddedGatewayTest, CallbackSeesExactlyWhatARemoteReaderReceives) {
   std::mutex mutex;
   std::vector<Bytes> from_callback;
-  gateway::EmbeddedGateway gateway(config(domain_, "embedded_same"), [&](const RobotState& sample) {
-    const std::lock_guard lock(mutex);
-    from_callback.push_back(frame_of(sample));
-  });
+  const std::string stats_file =
+      ::testing::TempDir() + "embedded_same_" + std::to_string(::getpid()) + ".json";
+  gateway::EmbeddedGateway gateway(config(domain_, "embedded_same", stats_file),
+                                   [&](const RobotState& sample) {
+                                     const std::lock_guard lock(mutex);
+                                     from_callback.push_back(frame_of(sample));
+                                   });
 
   dds::Participant participant(domain_, "rsg_participant");
   fdds::DataReaderQos qos = fdds::DATAREADER_QOS_DEFAULT;
@@ -72,6 +86,14 @@ TEST_F(EmbeddedGatewayTest, CallbackSeesExactlyWhatARemoteReaderReceives) {
     reader->get_subscription_matched_status(matched);
   }
   ASSERT_EQ(matched.current_count, 1) << "the embedded gateway's writer never matched";
+  // Discovery is not symmetric: the writer must have matched the reader too, or what it writes
+  // before then reaches nobody.
+  bool writer_matched = false;
+  for (int i = 0; i < 1000 && !writer_matched; ++i) {
+    writer_matched = stats_count_readers(stats_file, 1);
+    if (!writer_matched) std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(writer_matched) << "the embedded gateway's writer never counted the reader";
 
   std::mt19937_64 rng(3);
   std::vector<Bytes> sent;
@@ -102,6 +124,7 @@ TEST_F(EmbeddedGatewayTest, CallbackSeesExactlyWhatARemoteReaderReceives) {
   }
   participant.subscriber()->delete_datareader(reader);
   gateway.stop();
+  std::remove(stats_file.c_str());
 
   const std::lock_guard lock(mutex);
   ASSERT_EQ(from_callback.size(), sent.size());
