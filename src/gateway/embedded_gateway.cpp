@@ -13,7 +13,8 @@
 namespace rsg::gateway {
 namespace {
 
-// Everything rsg_gateway checks before it creates anything, plus the one thing embedding needs.
+// Everything rsg_gateway checks before it creates anything (the writer and reader profiles are
+// checked through its participant, once that exists), plus the one thing embedding needs.
 gateway::GatewaySetup prepare_embedded(std::string_view yaml_config,
                                        EmbeddedGateway::SampleCallback on_sample) {
   const gateway::ConfigResult parsed = gateway::parse_gateway_config(yaml_config);

@@ -45,12 +45,18 @@ InputError no_profile(const GatewayConfig& config, const std::string& kind, cons
   return InputError(profiles_of(config).string() + ": no " + kind + " profile named '" + name + "'");
 }
 
-void load_and_check_profiles(const GatewayConfig& config) {
-  dds::load_profiles(profiles_of(config));
+// The participant profile's QoS; looked up before anything exists, and again to create the participant.
+fdds::DomainParticipantQos profile_participant_qos(const GatewayConfig& config) {
   fdds::DomainParticipantQos qos;
   if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
           config.participant_profile, qos) != dds::kOk)
     throw no_profile(config, "participant", config.participant_profile);
+  return qos;
+}
+
+void load_and_check_profiles(const GatewayConfig& config) {
+  dds::load_profiles(profiles_of(config));
+  profile_participant_qos(config);
 }
 
 // Fast DDS only notices a missing writer or reader profile when an entity is created from it, after
@@ -84,11 +90,7 @@ dds::Participant& check_entity_profiles(dds::Participant& participant, const Gat
 // other ports (Fast DDS moves on to free ports if these are taken). A profile that sets <participantID>
 // itself is left alone.
 fdds::DomainParticipantQos participant_qos(const GatewayConfig& config) {
-  const std::string& profile = config.participant_profile;
-  fdds::DomainParticipantQos qos;
-  if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(profile, qos) !=
-      dds::kOk)
-    throw no_profile(config, "participant", profile);
+  fdds::DomainParticipantQos qos = profile_participant_qos(config);
   if (qos.wire_protocol().participant_id < 0)
     qos.wire_protocol().participant_id =
         static_cast<std::int32_t>(::getpid() % transport::kGatewayParticipantIds);

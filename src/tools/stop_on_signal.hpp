@@ -16,7 +16,9 @@ namespace rsg::tools {
 class StopOnSignal {
  public:
   /// Blocks SIGINT and SIGTERM, and SIGUSR1 `with_dump`, in the calling thread and in every thread
-  /// it starts from then on. Call it first in main, before DDS starts its threads.
+  /// it starts from then on. Call it first in main, before DDS starts its threads (Fast DDS 3 starts
+  /// some when the XML profiles load): a thread that leaves the signal unblocked can take it, and
+  /// discards it where it arrives ignored (a process started from a background job).
   static void block_stop_signals(bool with_dump = false) {
     const sigset_t signals = taken_signals(with_dump);
     pthread_sigmask(SIG_BLOCK, &signals, nullptr);

@@ -271,9 +271,7 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
   rsg::tools::init_logging("rsg_echo");
-  // Before anything starts a thread (Fast DDS 3 does when the profiles load): a thread that leaves
-  // SIGINT unblocked can take it, and discard it where SIGINT is ignored (a background job).
-  StopOnSignal::block_stop_signals();
+  StopOnSignal::block_stop_signals();  // before Fast DDS starts threads (stop_on_signal.hpp)
   CLI::App app{"Prints the RobotState samples of a topic, or of a group view of it.", "rsg_echo"};
   app.footer(
       "Views: view_poses (group 0), view_load_and_elbow (1), view_joints (2), view_contact (3), "

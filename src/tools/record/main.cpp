@@ -331,9 +331,7 @@ int run(const Options& options, rsg::tools::record::Profile profile) {
 
 int main(int argc, char** argv) {
   rsg::tools::init_logging("rsg_record");
-  // Before anything starts a thread (Fast DDS 3 does when the profiles load): a thread that leaves
-  // SIGINT unblocked can take it, and discard it where SIGINT is ignored (a background job).
-  StopOnSignal::block_stop_signals();
+  StopOnSignal::block_stop_signals();  // before Fast DDS starts threads (stop_on_signal.hpp)
   CLI::App app{"Records RobotState and GatewayStatus samples into an MCAP file.", "rsg_record"};
   app.footer(
       "Exit status: 0 after --duration or on SIGINT/SIGTERM (the file finished), 1 when the file cannot be "

@@ -282,9 +282,7 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
   rsg::tools::init_logging("rsg_replay");
-  // Before anything starts a thread (Fast DDS 3 does when the profiles load): a thread that leaves
-  // SIGINT unblocked can take it, and discard it where SIGINT is ignored (a background job).
-  StopOnSignal::block_stop_signals();
+  StopOnSignal::block_stop_signals();  // before Fast DDS starts threads (stop_on_signal.hpp)
   CLI::App app{"Plays an rsg_record MCAP file back as raw frames (--to) or DDS samples (--domain).",
                "rsg_replay"};
   app.footer(

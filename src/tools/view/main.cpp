@@ -171,9 +171,7 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
   rsg::tools::init_logging("rsg_view");
-  // Before anything starts a thread (Fast DDS 3 does when the profiles load): a thread that leaves
-  // SIGINT unblocked can take it, and discard it where SIGINT is ignored (a background job).
-  StopOnSignal::block_stop_signals();
+  StopOnSignal::block_stop_signals();  // before Fast DDS starts threads (stop_on_signal.hpp)
   CLI::App app{"Serves RobotState and GatewayStatus to Foxglove, PlotJuggler and a live web page.",
                "rsg_view"};
   app.footer(
