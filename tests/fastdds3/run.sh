@@ -89,10 +89,7 @@ else
     for tool in "$checkout/$host_build"/bin/rsg_*; do ln -s "$tool" "$dir/"; done
     for tool in "$@"; do
       rm -f "$dir/$tool"
-      # SIGINT back to its default first: started from a background job it arrives ignored, and
-      # chroot.sh could then not trap it to pass it on (bash cannot trap what it inherits ignored).
-      printf '#!/bin/sh\nexec env --default-signal=INT %s in %s "$@"\n' "$checkout/$chroot" \
-        "$checkout/$build/bin/$tool" > "$dir/$tool"
+      printf '#!/bin/sh\nexec %s in %s "$@"\n' "$checkout/$chroot" "$checkout/$build/bin/$tool" > "$dir/$tool"
       chmod +x "$dir/$tool"
     done
     echo "$dir"

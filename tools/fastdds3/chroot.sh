@@ -107,8 +107,12 @@ in_chroot() {
   return $status
 }
 
+# SIGINT back to its default on the way: started from a background job this script gets it
+# ignored, and bash can neither trap nor reset a signal it inherits ignored, so in_chroot could not
+# pass it on.
 exec_in_namespace() {
-  exec unshare --mount --propagation private -- env RSG_TRIXIE_MOUNTED="$root" "$0" __mounted "$@"
+  exec unshare --mount --propagation private -- env --default-signal=INT RSG_TRIXIE_MOUNTED="$root" "$0" \
+    __mounted "$@"
 }
 
 case ${1:-} in
