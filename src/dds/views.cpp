@@ -3,6 +3,7 @@
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 
 #include "rsg/dds/detail/fastdds_compat.hpp"
+#include "rsg/dds/group_filter.hpp"
 #include "rsg/error.hpp"
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/selection.hpp"
@@ -25,10 +26,17 @@ void check_groups(std::uint8_t groups) {
 // share it; a name already taken by something else is a configuration error, not a reuse.
 fdds::ContentFilteredTopic* find_or_create_filtered_topic(fdds::DomainParticipant& participant,
                                                           fdds::Topic& topic, const std::string& name,
-                                                          const std::string& filter) {
+                                                          const View& view) {
+  const std::string& filter = view.filter;
   fdds::TopicDescription* existing = participant.lookup_topicdescription(name);
   if (existing == nullptr) {
-    fdds::ContentFilteredTopic* created = participant.create_contentfilteredtopic(name, &topic, filter, {});
+    fdds::ContentFilteredTopic* created = nullptr;
+    if (view.groups != 0) {
+      register_group_filter(participant);
+      created = participant.create_contentfilteredtopic(name, &topic, filter, {}, kGroupFilterClass);
+    } else {
+      created = participant.create_contentfilteredtopic(name, &topic, filter, {});
+    }
     if (created == nullptr)
       throw ViewError("cannot create the filtered topic '" + name + "' with filter \"" + filter +
                       "\" (a DDS-SQL expression over RobotState's members?)");
@@ -81,6 +89,12 @@ View parse_view(const std::string& profile, const fdds::DataReaderQos& qos) {
   return View{.name = profile, .groups = *mask, .filter = group_filter_expression(*mask)};
 }
 
+void leave_filtering_to_readers(fdds::DataWriterQos& qos) {
+  // DataWriterImpl filters only with a reader filter slot to fill; with none it keeps no filter.
+  qos.writer_resource_limits().reader_filters_allocation.initial = 0;
+  qos.writer_resource_limits().reader_filters_allocation.maximum = 0;
+}
+
 fdds::DataReaderQos load_reader_qos(const fdds::Subscriber& subscriber, const std::string& profile) {
   fdds::DataReaderQos qos;
   if (subscriber.get_datareader_qos_from_profile(profile, qos) != rsg::dds::kOk)
@@ -103,24 +117,20 @@ ViewReader::ViewReader(fdds::Subscriber& subscriber, fdds::Topic& topic, const s
 ViewReader::ViewReader(fdds::Subscriber& subscriber, fdds::Topic& topic, View view,
                        const fdds::DataReaderQos& qos, fdds::DataReaderListener* listener,
                        const fdds::StatusMask& mask)
-    : subscriber_(subscriber), view_(std::move(view)) {
+    : view_(std::move(view)) {
   fdds::DomainParticipant& participant = *topic.get_participant();
   if (subscriber.get_participant() != &participant)
     throw std::logic_error("ViewReader: subscriber and topic belong to different participants");
   const std::string name = topic.get_name() + "/" + view_.name;
-  filtered_topic_ = find_or_create_filtered_topic(participant, topic, name, view_.filter);
-  reader_ = subscriber.create_datareader(filtered_topic_, qos, listener, mask);
-  if (reader_ == nullptr) {
-    participant.delete_contentfilteredtopic(filtered_topic_);  // refused while another reader uses it
-    throw EnvironmentError("cannot create a reader on '" + name + "' (inconsistent reader QoS?)");
-  }
+  filtered_topic_.reset(find_or_create_filtered_topic(participant, topic, name, view_));
+  reader_ = own(subscriber, subscriber.create_datareader(filtered_topic_.get(), qos, listener, mask),
+                "a reader on '" + name + "' (inconsistent reader QoS?)");
 }
 
-ViewReader::~ViewReader() {
-  subscriber_.delete_datareader(reader_);
+void ViewReader::ReleaseFilteredTopic::operator()(fdds::ContentFilteredTopic* topic) const {
   // Fast DDS refuses (PRECONDITION_NOT_MET) while another reader still uses the filtered topic;
   // the last ViewReader on the view deletes it.
-  filtered_topic_->get_participant()->delete_contentfilteredtopic(filtered_topic_);
+  topic->get_participant()->delete_contentfilteredtopic(topic);
 }
 
 }  // namespace rsg::dds

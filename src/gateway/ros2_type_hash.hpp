@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "rsg/dds/detail/fastdds_compat.hpp"
+#include "rsg/dds/views.hpp"
 #include "rsg_ros2_type_hashes.hpp"
 
 namespace rsg::gateway {
@@ -45,15 +46,17 @@ inline void announce_ros2_type_hash(eprosima::fastdds::dds::UserDataQosPolicy& u
   user_data.setValue(std::vector<rsg::dds::rtps::octet>(text.begin(), text.end()));
 }
 
-/// create_datawriter_with_profile, with the topic type's hash announced when it has one.
+/// create_datawriter_with_profile, with the topic type's hash announced when it has one, and
+/// content filtering left to the readers (rsg::dds::leave_filtering_to_readers: no reader's filter
+/// may run on the gateway's ingress thread).
+/// @return nullptr when the profile is unknown or Fast DDS refuses the writer.
 inline eprosima::fastdds::dds::DataWriter* create_writer_with_profile(
     eprosima::fastdds::dds::Publisher& publisher, eprosima::fastdds::dds::Topic* topic,
     const std::string& profile) {
   eprosima::fastdds::dds::DataWriterQos qos;
-  if (ros2_type_hash(topic->get_type_name()).empty() ||
-      publisher.get_datawriter_qos_from_profile(profile, qos) != rsg::dds::kOk)
-    return publisher.create_datawriter_with_profile(topic, profile);
+  if (publisher.get_datawriter_qos_from_profile(profile, qos) != rsg::dds::kOk) return nullptr;
   announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
+  rsg::dds::leave_filtering_to_readers(qos);
   return publisher.create_datawriter(topic, qos);
 }
 

@@ -1,8 +1,10 @@
-// Where Fast DDS 2.9 evaluates a view's filter, measured on the wire: the publishing participant's
-// transport records the sequence number of every user sample it sends. For a remote UDP reader
-// the writer filters (only the samples the view accepts are sent); it stops doing so when writer
-// filtering is disabled or the writer's liveliness lease is finite (Fast DDS only filters for
-// writers with infinite liveliness: docs "Conditions for writer side filtering").
+// Where a view's filter is evaluated, measured on the wire: the publishing participant's transport
+// records the sequence number of every user sample it sends. A writer whose participant knows the
+// view's filter class filters for a remote UDP reader (only the samples the view accepts are sent);
+// it stops doing so when writer filtering is disabled (rsg::dds::leave_filtering_to_readers, what
+// rsg's own writers do) or the writer's liveliness lease is finite (Fast DDS only filters for
+// writers with infinite liveliness: docs "Conditions for writer side filtering"). Either way the
+// reader gets exactly the samples its view accepts.
 //
 // Two participants in one process, intra-process delivery off, so that the reader is remote to
 // the writer in every respect but the process.
@@ -16,6 +18,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
 #include "mixed_stream.hpp"
+#include "rsg/dds/group_filter.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
@@ -49,8 +52,10 @@ struct Outcome {
 };
 
 enum class Delivery { kUdp, kDataSharing };
+enum class WriterKnowsGroupFilter { kNo, kYes };
 
-Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qos, Delivery delivery) {
+Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qos, Delivery delivery,
+                                       WriterKnowsGroupFilter knows = WriterKnowsGroupFilter::kYes) {
   dds::disable_intraprocess_delivery();
   dds::load_profiles(dds::default_profiles_dir());
   const int domain = static_cast<int>(::getpid() % 200 + 10);
@@ -60,6 +65,7 @@ Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qo
       participant_with(std::make_shared<test::SentDataRecordingTransportDescriptor>(sent), domain);
   auto subscribing =
       participant_with(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(), domain);
+  if (knows == WriterKnowsGroupFilter::kYes) dds::register_group_filter(*publishing->get());
 
   // Reliable, so that nothing is lost in the burst; a repair resends a sequence number already
   // recorded, and samples filtered out are announced as GAPs, not sent as DATA.
@@ -134,16 +140,27 @@ TEST(WriterSideFiltering, AWriterWithFiniteLivelinessSendsEverything) {
   EXPECT_EQ(outcome.received, outcome.accepted) << "the reader must filter instead";
 }
 
-// The QoS the gateway really publishes with (xml_profiles/gateway.xml).
-TEST(WriterSideFiltering, TheGatewayWriterProfileKeepsRejectedSamplesOffTheWire) {
+// A writer that does not know the group filter class (an older rsg, another vendor) cannot
+// evaluate it: it sends everything and the reader filters.
+TEST(WriterSideFiltering, AWriterWithoutTheGroupFilterClassSendsEverything) {
+  const Outcome outcome = publish_mixed_stream_to_a_view(fdds::DATAWRITER_QOS_DEFAULT, Delivery::kUdp,
+                                                         WriterKnowsGroupFilter::kNo);
+  EXPECT_EQ(outcome.sent.size(), outcome.written);
+  EXPECT_EQ(outcome.received, outcome.accepted) << "the reader must filter instead";
+}
+
+// The QoS the gateway really publishes with (xml_profiles/gateway.xml, then
+// leave_filtering_to_readers): no filter runs in the writer, the view's reader filters.
+TEST(WriterSideFiltering, TheGatewayWriterLeavesFilteringToTheReaders) {
   dds::disable_intraprocess_delivery();  // before `any`: Fast DDS 3 ignores it after a participant
   dds::load_profiles(dds::default_profiles_dir());
   dds::Participant any(static_cast<int>(::getpid() % 200 + 10), "");
   fdds::DataWriterQos gateway_qos;
   ASSERT_EQ(any.publisher()->get_datawriter_qos_from_profile("rsg_state_writer", gateway_qos), rsg::dds::kOk);
+  dds::leave_filtering_to_readers(gateway_qos);
   const Outcome outcome = publish_mixed_stream_to_a_view(gateway_qos, Delivery::kUdp);
   ASSERT_LT(outcome.accepted.size(), outcome.written);
-  EXPECT_EQ(outcome.sent, outcome.accepted) << "the gateway's writer put rejected samples on the wire";
+  EXPECT_EQ(outcome.sent.size(), outcome.written) << "the gateway's writer evaluated a reader's filter";
   EXPECT_EQ(outcome.received, outcome.accepted);
 }
 

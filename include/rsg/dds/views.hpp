@@ -1,32 +1,38 @@
 // Group views: readers that receive only the RobotState samples carrying the groups they need.
 //
 // A view on groups S delivers exactly the samples whose group_select contains every group of S
-// (other groups may be present too). It is a ContentFilteredTopic with the DDS-SQL filter
+// (other groups may be present too). It is a ContentFilteredTopic whose expression is the DDS-SQL
 //
 //     group_present[2] = TRUE AND group_present[3] = TRUE
 //
-// which any DDS application can create itself; this library builds it from a view profile of
-// xml_profiles/views.xml and combines it with a reader QoS profile (`reader_realtime`,
-// `reader_logger`):
+// which any DDS application can use with Fast DDS's DDSSQL filter class; rsg's own view readers
+// evaluate the same expression with the group filter class (group_filter.hpp), a byte and a mask
+// per sample. This library builds the view from a view profile of xml_profiles/views.xml and
+// combines it with a reader QoS profile (`reader_realtime`, `reader_logger`):
 //
 //   rsg::dds::Participant participant(domain, "rsg_participant");
 //   auto* topic = participant.robot_state_topic("robot_state");
 //   rsg::dds::ViewReader joints(*participant.subscriber({"robot1"}), *topic, "view_joints",
 //                          rsg::dds::kRealtimeReaderProfile, &listener);
 //
-// Fast DDS evaluates the filter in the writer for remote UDP readers, so samples a view rejects
-// never cross the network; for data-sharing and intra-process readers it evaluates it in the reader.
+// Where the filter runs: rsg's writers (the gateway's, rsg_replay's) leave it to the readers
+// (leave_filtering_to_readers), so a reader's filter, rsg's or a foreign DDS-SQL one, costs its
+// own process and never the gateway; every view reader receives the stream a plain reader does
+// and drops what its view rejects (docs/operating.md, "Views and writer-side filtering").
 #pragma once
 
 #include <cstdint>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/topic/ContentFilteredTopic.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
+#include <memory>
 #include <string>
 
+#include "rsg/dds/owned.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::dds {
@@ -71,6 +77,12 @@ View parse_view(const std::string& profile, const eprosima::fastdds::dds::DataRe
 /// @throws ViewError for an unknown or unusable profile.
 View load_view(const eprosima::fastdds::dds::Subscriber& subscriber, const std::string& profile);
 
+/// Makes a writer with `qos` evaluate no reader's content filter: every matched reader gets every
+/// sample and filters it itself. Fast DDS 2.9.1 deletes a leaving reader's filter while write()
+/// may be evaluating it (a crash, fixed upstream in 3.0), and a DDS-SQL filter costs the writer a
+/// DynamicData per sample per reader: neither may reach the gateway's ingress thread.
+void leave_filtering_to_readers(eprosima::fastdds::dds::DataWriterQos& qos);
+
 /// Reads an XML data_reader profile's QoS, with which a reader takes plain samples in place on
 /// either Fast DDS (read_plain_samples_in_place()).
 /// @throws ViewError naming an unknown profile.
@@ -80,8 +92,9 @@ eprosima::fastdds::dds::DataReaderQos load_reader_qos(const eprosima::fastdds::d
 /// A DataReader on a view of a RobotState topic, deleted with this object.
 ///
 /// The ContentFilteredTopic "<topic>/<view>" is shared by every ViewReader of the participant on
-/// that view and deleted with the last of them. The subscriber and topic must outlive the reader
-/// (declare the Participant first).
+/// that view and deleted with the last of them. A group view uses the group filter class
+/// (registered on the participant here), a raw filter view DDSSQL. The subscriber and topic must outlive the
+/// reader (declare the Participant first).
 class ViewReader {
  public:
   /// A reader on the view `view_profile` with the QoS of `qos_profile`; an empty `qos_profile`
@@ -98,21 +111,25 @@ class ViewReader {
              const eprosima::fastdds::dds::DataReaderQos& qos,
              eprosima::fastdds::dds::DataReaderListener* listener = nullptr,
              const eprosima::fastdds::dds::StatusMask& mask = eprosima::fastdds::dds::StatusMask::all());
-  ~ViewReader();
   ViewReader(const ViewReader&) = delete;
   ViewReader& operator=(const ViewReader&) = delete;
 
-  eprosima::fastdds::dds::DataReader* get() const { return reader_; }
-  eprosima::fastdds::dds::DataReader* operator->() const { return reader_; }
+  eprosima::fastdds::dds::DataReader* get() const { return reader_.get(); }
+  eprosima::fastdds::dds::DataReader* operator->() const { return reader_.get(); }
   const View& view() const { return view_; }
   /// The filtered topic the reader reads, "<topic>/<view name>".
-  eprosima::fastdds::dds::ContentFilteredTopic* filtered_topic() const { return filtered_topic_; }
+  eprosima::fastdds::dds::ContentFilteredTopic* filtered_topic() const { return filtered_topic_.get(); }
 
  private:
-  eprosima::fastdds::dds::Subscriber& subscriber_;
+  // Deletes the filtered topic unless another ViewReader still reads it (Fast DDS refuses then).
+  struct ReleaseFilteredTopic {
+    void operator()(eprosima::fastdds::dds::ContentFilteredTopic* topic) const;
+  };
+
   View view_;
-  eprosima::fastdds::dds::ContentFilteredTopic* filtered_topic_ = nullptr;
-  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
+  // Declared before the reader, so that the reader goes first.
+  std::unique_ptr<eprosima::fastdds::dds::ContentFilteredTopic, ReleaseFilteredTopic> filtered_topic_;
+  OwnedReader reader_;
 };
 
 }  // namespace rsg::dds

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
 #include <optional>
 #include <thread>
 #include <unordered_set>
@@ -24,6 +25,7 @@
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
+#include "rsg/dds/views.hpp"
 #include "rsg/error.hpp"
 #include "rsg/transport/udp_socket.hpp"
 #include "stop_on_signal.hpp"
@@ -92,12 +94,21 @@ class DdsOutput final : public Output {
  public:
   DdsOutput(const Options& options)
       : participant_(*options.domain, options.participant_profile, options.discovery),
-        writer_(participant_.publisher(options.partitions)
-                    ->create_datawriter_with_profile(participant_.robot_state_topic(options.topic),
-                                                     options.writer_profile)) {
+        writer_(create_writer(participant_, options)) {
     if (writer_ == nullptr)
       throw rsg::EnvironmentError("cannot create a writer with profile '" + options.writer_profile + "'");
   }
+  // Like the gateway's writer, it leaves view filters to the readers (rsg::dds::leave_filtering_to_readers).
+  static eprosima::fastdds::dds::DataWriter* create_writer(rsg::dds::Participant& participant,
+                                                           const Options& options) {
+    eprosima::fastdds::dds::Publisher* publisher = participant.publisher(options.partitions);
+    eprosima::fastdds::dds::DataWriterQos qos;
+    if (publisher->get_datawriter_qos_from_profile(options.writer_profile, qos) != rsg::dds::kOk)
+      return nullptr;
+    rsg::dds::leave_filtering_to_readers(qos);
+    return publisher->create_datawriter(participant.robot_state_topic(options.topic), qos);
+  }
+
   bool send(const rsg::RobotState& sample) override {
     if (rsg::dds::succeeded(writer_->write(const_cast<rsg::RobotState*>(&sample)))) return true;
     spdlog::error("the DDS writer refused a sample");

@@ -9,7 +9,7 @@
 // codes, `.h` -> `.hpp` RTPS headers, TopicDataType's members, the library settings, discovery
 // servers) is named here once, and the rest of the tree uses these names:
 //
-//   rsg::dds::kOk, Duration, kInfinite   return code and times
+//   rsg::dds::kOk, kBadParameter, Duration, kInfinite   return codes and times
 //   rsg::dds::rtps                       the RTPS namespace (GUID_t, Locator_t, IPLocator, ...)
 //   rsg::dds::serialize, deserialize, max_serialized_size, is_plain, rename_type
 //   rsg::dds::succeeded, is_keyed, disable_intraprocess_delivery, read_plain_samples_in_place
@@ -74,6 +74,7 @@ namespace rtps = eprosima::fastdds::rtps;
 using Duration = eprosima::fastdds::dds::Duration_t;
 using ReturnCode = eprosima::fastdds::dds::ReturnCode_t;
 inline constexpr ReturnCode kOk = eprosima::fastdds::dds::RETCODE_OK;
+inline constexpr ReturnCode kBadParameter = eprosima::fastdds::dds::RETCODE_BAD_PARAMETER;
 inline const Duration kInfinite = eprosima::fastdds::dds::c_TimeInfinite;
 using DiscoveryProtocol = rtps::DiscoveryProtocol;
 
@@ -270,6 +271,7 @@ namespace rtps = eprosima::fastrtps::rtps;
 using Duration = eprosima::fastrtps::Duration_t;
 using ReturnCode = eprosima::fastrtps::types::ReturnCode_t;
 inline const ReturnCode kOk = ReturnCode::RETCODE_OK;
+inline const ReturnCode kBadParameter = ReturnCode::RETCODE_BAD_PARAMETER;
 inline const Duration kInfinite = eprosima::fastrtps::c_TimeInfinite;
 using DiscoveryProtocol = rtps::DiscoveryProtocol_t;
 
