@@ -271,6 +271,7 @@ void Gateway::on_status_period(Clock::time_point now) {
     ingress_->log_rejections();
   }
   const GatewayStats stats = snapshot();
+  if (ingress_) ingress_->end_status_period();
   status_.publish(stats);
   write_stats_file(stats);
   if (now >= next_summary_) {

@@ -12,13 +12,18 @@ namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;
 namespace {
 
-std::optional<std::uint64_t> frame_time(const wire::FrameView& frame) {
-  const auto bytes = frame.field_bytes(wire::Field::time);
-  if (bytes.empty()) return std::nullopt;
-  std::uint64_t value = 0;
-  for (std::size_t i = 0; i < bytes.size(); ++i)
-    value |= std::uint64_t{bytes[i]} << (8 * i);  // little-endian
-  return value;
+// The robot's `time`, from the sample the codec just decoded the frame into, when the frame carried it.
+std::optional<std::uint64_t> frame_time(const wire::FrameView& frame, const RobotState& sample) {
+  if (!frame.contains(wire::Field::time)) return std::nullopt;
+  return sample.time();
+}
+
+// When the kernel queued a datagram, on the gateway's clock: `arrived` is wall-clock time, and
+// `wall_now` and `now` were read together. A datagram without a time stamp counts as arriving now.
+Clock::time_point arrival_of(std::chrono::system_clock::time_point arrived, Clock::time_point now,
+                             std::chrono::system_clock::time_point wall_now) {
+  if (arrived.time_since_epoch().count() == 0 || arrived > wall_now) return now;
+  return now - std::chrono::duration_cast<Clock::duration>(wall_now - arrived);
 }
 
 /// The sample a frame is decoded into: a loan from the writer when it has one to give, else the
@@ -66,6 +71,9 @@ Ingress::Ingress(dds::Participant& participant, Options options)
       batch_(kBatchDatagrams, wire::kMaxFrameBytes),
       sequence_(options_.restart_threshold_ms),
       link_(options_.nominal_period) {
+  // The link monitor and the delay counters judge by when frames arrived, not by when a busy
+  // ingress got round to them.
+  socket_.timestamp_arrivals();
   if (options_.receive_buffer > 0) {
     const int granted = socket_.set_receive_buffer(options_.receive_buffer);
     if (granted < options_.receive_buffer)
@@ -113,13 +121,18 @@ void Ingress::receive(std::chrono::milliseconds timeout) {
     const std::size_t received = socket_.receive_batch(batch_);
     // Every datagram of a batch was queued by now: one clock reading serves them all.
     const auto now = Clock::now();
-    if (recorder_ && received) recorder_->commit(batch_, received, std::chrono::system_clock::now());
-    for (std::size_t i = 0; i < received; ++i) handle(batch_[i], now);
+    const auto wall_now = std::chrono::system_clock::now();
+    if (recorder_ && received) recorder_->commit(batch_, received, wall_now);
+    for (std::size_t i = 0; i < received; ++i) {
+      const transport::DatagramBatch::Datagram datagram = batch_[i];
+      handle(datagram, now, arrival_of(datagram.arrived, now, wall_now));
+    }
     if (received < batch_.capacity()) return;  // the queue was empty; the next poll waits for more
   }
 }
 
-void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::time_point now) {
+void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::time_point now,
+                     Clock::time_point arrival) {
   if (!options_.sources.allows(datagram.from.address())) {
     ++counters_.rejected_source;
     last_foreign_sender_ = datagram.from;
@@ -150,9 +163,9 @@ void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::
   }
   const wire::FrameView& frame = decoded.frame();
 
-  const std::optional<std::uint64_t> robot_time_ms = frame_time(frame);
+  const std::optional<std::uint64_t> robot_time_ms = frame_time(frame, slot.sample());
   sequence_.observe(frame.packet_number(), robot_time_ms);
-  link_came_up_ |= link_.on_frame(now);
+  link_came_up_ |= link_.on_frame(arrival);
   source_ = datagram.from;
   if (requester_ && requester_->due(frame.selection(), now))
     request_selection(options_.robot ? *options_.robot : datagram.from, now);
@@ -171,6 +184,9 @@ void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::
     ++counters_.published;
   else
     ++counters_.publish_failed;
+  const auto delay = Clock::now() - arrival;
+  delay_period_max_ = std::max(delay_period_max_, delay);
+  delay_max_ = std::max(delay_max_, delay);
 }
 
 void Ingress::write_rate_topics(const RobotState& sample, std::chrono::nanoseconds t) {
@@ -207,9 +223,13 @@ std::optional<FlightRecorder::Dump> Ingress::dump_flight_recorder(std::string_vi
 
 bool Ingress::link_changed(Clock::time_point now) {
   const bool came_up = std::exchange(link_came_up_, false);
-  const bool went_down = link_.poll(now);
+  // Silence is judged only with the socket drained: a datagram still queued arrived after the
+  // last one handled, so the robot was not silent, however long the gateway took to get here.
+  const bool went_down = link_.up() && now >= link_.deadline() && !socket_.has_queued() && link_.poll(now);
   return came_up || went_down;
 }
+
+void Ingress::end_status_period() { delay_period_max_ = {}; }
 
 void Ingress::fill(GatewayStats& stats) const {
   stats.ingress = counters_;
@@ -221,6 +241,11 @@ void Ingress::fill(GatewayStats& stats) const {
   stats.source = source_.size() ? source_.to_string() : std::string();
   stats.standard_dropped = standard_topics_ ? standard_topics_->dropped() : 0;
   stats.standard_readers = standard_topics_ ? standard_topics_->matched_readers() : 0;
+  const auto micros = [](Clock::duration d) {
+    return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(d).count());
+  };
+  stats.ingress_delay_us = micros(delay_period_max_);
+  stats.ingress_delay_max_us = micros(delay_max_);
 }
 
 void Ingress::log_rejections() {

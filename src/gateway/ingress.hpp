@@ -76,7 +76,8 @@ class Ingress {
   static constexpr std::size_t kBatchDatagrams = 32;  ///< per recvmmsg: 32 ms of frames at 1 kHz
   static constexpr std::size_t kMaxBatchesPerWake = 8;
 
-  /// True once for every link change: up on a frame after silence, down on `poll` after silence.
+  /// True once for every link change: up on a frame after silence, down after silence, judged by
+  /// the frames' arrival times and only while no datagram is queued.
   bool link_changed(Clock::time_point now);
   /// When `link_changed` must be asked next at the latest to notice silence in time.
   Clock::time_point link_deadline() const { return link_.deadline(); }
@@ -86,6 +87,8 @@ class Ingress {
 
   /// Adds this side's counters to `stats`.
   void fill(GatewayStats& stats) const;
+  /// Starts a new status period for the per-period figures (ingress_delay_us).
+  void end_status_period();
 
   /// Logs one line when frames were rejected since the last call (the caller calls it once a second).
   void log_rejections();
@@ -103,7 +106,8 @@ class Ingress {
   }
 
  private:
-  void handle(const transport::DatagramBatch::Datagram& datagram, Clock::time_point now);
+  void handle(const transport::DatagramBatch::Datagram& datagram, Clock::time_point now,
+              Clock::time_point arrival);
   void reject(const wire::FrameError& error, const transport::Endpoint& sender);
   void request_selection(const transport::Endpoint& robot, Clock::time_point now);
   void write_rate_topics(const RobotState& sample, std::chrono::nanoseconds t);
@@ -133,6 +137,8 @@ class Ingress {
   SequenceTracker sequence_;
   LinkMonitor link_;
   bool link_came_up_ = false;
+  Clock::duration delay_period_max_{};      // arrival -> publication, this status period
+  Clock::duration delay_max_{};             // and since start
   std::optional<FlightRecorder> recorder_;  // receives into its ring instead of batch_'s storage
   std::optional<SelectionRequester> requester_;
   std::uint8_t request_packet_number_ = 0;

@@ -37,6 +37,8 @@ std::string to_json(const GatewayStats& stats) {
       {"egress_unencodable", stats.egress.unencodable},
       {"egress_send_failed", stats.egress.send_failed},
       {"standard_dropped", stats.standard_dropped},
+      {"ingress_delay_us", stats.ingress_delay_us},
+      {"ingress_delay_max_us", stats.ingress_delay_max_us},
   };
   return json.dump();
 }
@@ -66,6 +68,8 @@ std::string summary_line(const GatewayStats& stats) {
     line += fmt::format("; egress samples {} sent {} unencodable {} send_failed {}", out.samples,
                         out.frames_sent, out.unencodable, out.send_failed);
   if (stats.standard_dropped) line += fmt::format("; standard_dropped {}", stats.standard_dropped);
+  line +=
+      fmt::format("; ingress delay {} us (max {} us)", stats.ingress_delay_us, stats.ingress_delay_max_us);
   return line;
 }
 

@@ -53,6 +53,10 @@ struct GatewayStats {
   /// Snapshots for the ROS 2 standard topics dropped because their publishing thread was a whole
   /// ring behind (Ros2StandardTopics::dropped()); 0 when those topics are off.
   std::uint64_t standard_dropped = 0;
+  /// The longest time from a valid frame's arrival at the socket (kernel time stamp) to its
+  /// publication, over the last status period and since start: how far the ingress runs behind.
+  std::uint64_t ingress_delay_us = 0;
+  std::uint64_t ingress_delay_max_us = 0;
   double rate_hz = 0;  ///< valid frames per second over the last status period
   bool link_up = false;
   std::string source;  ///< "HOST:PORT" of the last valid frame, empty before the first

@@ -43,6 +43,8 @@ void to_status_sample(const GatewayStats& stats, GatewayStatus& sample) {
   sample.egress_unencodable(stats.egress.unencodable);
   sample.egress_send_failed(stats.egress.send_failed);
   sample.standard_dropped(stats.standard_dropped);
+  sample.ingress_delay_us(stats.ingress_delay_us);
+  sample.ingress_delay_max_us(stats.ingress_delay_max_us);
 }
 
 GatewayStats from_status_sample(const GatewayStatus& sample) {
@@ -67,6 +69,8 @@ GatewayStats from_status_sample(const GatewayStatus& sample) {
                   .unencodable = sample.egress_unencodable(),
                   .send_failed = sample.egress_send_failed()};
   stats.standard_dropped = sample.standard_dropped();
+  stats.ingress_delay_us = sample.ingress_delay_us();
+  stats.ingress_delay_max_us = sample.ingress_delay_max_us();
   return stats;
 }
 

@@ -66,7 +66,9 @@ DatagramBatch::DatagramBatch(std::size_t capacity, std::size_t buffer_bytes)
       storage_(capacity * buffer_bytes),
       senders_(capacity),
       slots_(capacity),
-      headers_(capacity) {
+      headers_(capacity),
+      control_(capacity * kControlWords) {
+  static_assert(CMSG_SPACE(sizeof(timespec)) <= kControlWords * sizeof(std::uint64_t));
   for (std::size_t i = 0; i < capacity; ++i) {
     slots_[i] = {storage_.data() + i * buffer_bytes, buffer_bytes};
     msghdr& header = headers_[i].msg_hdr;
@@ -85,8 +87,20 @@ DatagramBatch::Datagram DatagramBatch::operator[](std::size_t index) const {
   // With MSG_TRUNC in the receive flags msg_len is the real size; msg_flags says whether it was cut.
   const bool truncated = (header.msg_hdr.msg_flags & MSG_TRUNC) != 0 || header.msg_len > buffer_bytes_;
   const std::size_t kept = std::min<std::size_t>(header.msg_len, buffer_bytes_);
+  std::chrono::system_clock::time_point arrived{};
+  // The header is const here; CMSG_* want a mutable one and only read through it.
+  auto& readable = const_cast<msghdr&>(header.msg_hdr);
+  for (cmsghdr* message = CMSG_FIRSTHDR(&readable); message != nullptr;
+       message = CMSG_NXTHDR(&readable, message)) {
+    if (message->cmsg_level != SOL_SOCKET || message->cmsg_type != SCM_TIMESTAMPNS) continue;
+    timespec stamp{};
+    std::memcpy(&stamp, CMSG_DATA(message), sizeof stamp);
+    arrived =
+        std::chrono::system_clock::time_point(std::chrono::duration_cast<std::chrono::system_clock::duration>(
+            std::chrono::seconds(stamp.tv_sec) + std::chrono::nanoseconds(stamp.tv_nsec)));
+  }
   return {std::span(static_cast<const std::uint8_t*>(slots_[index].iov_base), kept), header.msg_len,
-          truncated, senders_[index]};
+          truncated, senders_[index], arrived};
 }
 
 UdpSocket UdpSocket::bind(const Endpoint& local) {
@@ -141,9 +155,12 @@ bool UdpSocket::wait_readable(std::chrono::milliseconds timeout) {
 
 std::size_t UdpSocket::receive_batch(DatagramBatch& batch) {
   batch.size_ = 0;
-  for (mmsghdr& header : batch.headers_) {
-    header.msg_hdr.msg_namelen = sizeof(sockaddr_storage);  // the kernel shrinks it to the sender's
-    header.msg_hdr.msg_flags = 0;
+  for (std::size_t i = 0; i < batch.headers_.size(); ++i) {
+    msghdr& header = batch.headers_[i].msg_hdr;
+    header.msg_namelen = sizeof(sockaddr_storage);  // the kernel shrinks it to the sender's
+    header.msg_flags = 0;
+    header.msg_control = &batch.control_[i * DatagramBatch::kControlWords];  // and this to what it wrote
+    header.msg_controllen = DatagramBatch::kControlWords * sizeof(std::uint64_t);
   }
   const int received = ::recvmmsg(fd_, batch.headers_.data(), static_cast<unsigned>(batch.headers_.size()),
                                   MSG_DONTWAIT | MSG_TRUNC, nullptr);
@@ -159,6 +176,13 @@ std::size_t UdpSocket::receive_batch(DatagramBatch& batch) {
 bool UdpSocket::send_to(std::span<const std::uint8_t> datagram, const Endpoint& to) {
   return ::sendto(fd_, datagram.data(), datagram.size(), 0, to.address(), to.size()) ==
          static_cast<ssize_t>(datagram.size());
+}
+
+void UdpSocket::timestamp_arrivals() {
+  const int on = 1;
+  if (::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on) != 0)
+    throw EnvironmentError(std::string("cannot time-stamp UDP arrivals (SO_TIMESTAMPNS): ") +
+                           std::strerror(errno));
 }
 
 int UdpSocket::set_receive_buffer(int bytes) {

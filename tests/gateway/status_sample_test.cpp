@@ -23,6 +23,8 @@ GatewayStats distinct_stats() {
   stats.standard_readers = 16;
   stats.egress = {.samples = 9, .frames_sent = 10, .unencodable = 11, .send_failed = 12};
   stats.standard_dropped = 15;
+  stats.ingress_delay_us = 17;
+  stats.ingress_delay_max_us = 18;
   return stats;
 }
 
@@ -89,6 +91,8 @@ TEST(StatsJson, UsesTheStatusNamesAndCategoryNames) {
   EXPECT_EQ(json["invalid"].size(), wire::kErrorCategoryCount);
   EXPECT_EQ(json["source"], "192.0.2.1:40000");
   EXPECT_EQ(json["standard_dropped"], 15);
+  EXPECT_EQ(json["ingress_delay_us"], 17);
+  EXPECT_EQ(json["ingress_delay_max_us"], 18);
 }
 
 TEST(StatsSummary, NamesOnlyTheCategoriesThatOccurred) {

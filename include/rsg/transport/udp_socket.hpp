@@ -54,6 +54,8 @@ class DatagramBatch {
     std::size_t size;                     ///< the datagram's real size
     bool truncated;                       ///< longer than its buffer: `bytes` is only its start
     const Endpoint& from;
+    /// When the kernel queued it (UdpSocket::timestamp_arrivals); the epoch when it did not say.
+    std::chrono::system_clock::time_point arrived;
   };
 
   DatagramBatch(std::size_t capacity, std::size_t buffer_bytes);
@@ -82,6 +84,9 @@ class DatagramBatch {
   std::vector<Endpoint> senders_;
   std::vector<iovec> slots_;
   std::vector<mmsghdr> headers_;
+  // Per datagram, room for its arrival time stamp (a cmsghdr and a timespec), cmsghdr-aligned.
+  static constexpr std::size_t kControlWords = 8;
+  std::vector<std::uint64_t> control_;
 };
 
 class UdpSocket {
@@ -114,6 +119,14 @@ class UdpSocket {
   /// Sends one datagram.
   /// @return false (errno kept) when the kernel refused it.
   bool send_to(std::span<const std::uint8_t> datagram, const Endpoint& to);
+
+  /// Makes the kernel stamp every datagram with the time it was queued (SO_TIMESTAMPNS), which
+  /// `receive_batch` hands out as Datagram::arrived: what a busy receiver was doing meanwhile does
+  /// not move it.
+  /// @throws rsg::EnvironmentError when the kernel refuses.
+  void timestamp_arrivals();
+  /// Whether a datagram is queued now (never waits).
+  bool has_queued() { return wait_readable(std::chrono::milliseconds(0)); }
 
   /// Asks for a larger kernel receive buffer so bursts at 1 kHz+ are not dropped.
   /// @return the size the kernel granted.
