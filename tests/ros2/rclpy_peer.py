@@ -12,9 +12,14 @@ project's ROS 2 environment (ros2/env.sh), never imported by the tests themselve
   graph TOPIC... [--wait-publishers N] [--subscriptions] [--timeout S]
       prints, per topic, what `ros2 topic info -v` shows: get_publishers_info_by_topic (or with
       --subscriptions get_subscriptions_info_by_topic) as JSON
-  churn --count N --topic TOPIC [--hold S]
+  churn --count N --topic TOPIC [--hold S] [--filter EXPR]
       N times: rclpy.init (a new DDS participant), a node with a default-QoS RobotState
-      subscription, wait for its match and one message (at most --hold s), shut down
+      subscription (content-filtered with --filter), wait for its match and one message (at most
+      --hold s), shut down; with --filter every message must pass it (group_present terms only)
+  hold --count N [--filter EXPR] --seconds S
+      N RobotState subscriptions (default QoS, content-filtered with --filter) held for S seconds
+      without spinning: what a gateway pays for N such readers (make bench's readers suite); the
+      node's own cost is not what it measures
 TYPE is pkg/msg/Name. Topic names are ROS names (relative ones resolve in the root namespace).
 """
 import argparse
@@ -184,6 +189,7 @@ def graph(args):
 
 def churn(args):
     from rsg_msgs.msg import RobotState  # noqa: the churned nodes read the gateway's state
+    wrong = [0]
     for index in range(args.count):
         context = rclpy.Context()
         rclpy.init(context=context)
@@ -194,8 +200,19 @@ def churn(args):
         def on_matched(info, matched=matched):
             matched[0] = info.current_count
 
-        node.create_subscription(RobotState, args.topic, lambda message, got=got: got.set(), QoSProfile(depth=10),
-                                 event_callbacks=SubscriptionEventCallbacks(matched=on_matched))
+        options = {}
+        if args.filter:
+            options["content_filter_options"] = ContentFilterOptions(filter_expression=args.filter,
+                                                                     expression_parameters=[])
+
+        def on_message(message, got=got):
+            if args.filter and not all(message.group_present[int(term.split("[")[1].split("]")[0])]
+                                       for term in args.filter.split(" AND ")):
+                wrong[0] += 1
+            got.set()
+
+        node.create_subscription(RobotState, args.topic, on_message, QoSProfile(depth=10),
+                                 event_callbacks=SubscriptionEventCallbacks(matched=on_matched), **options)
         executor = rclpy.executors.SingleThreadedExecutor(context=context)
         executor.add_node(node)
         deadline = time.monotonic() + args.hold
@@ -205,7 +222,21 @@ def churn(args):
         executor.shutdown()
         node.destroy_node()
         rclpy.shutdown(context=context)
-    say(f"churned {args.count}")
+    say(f"churned {args.count}, messages failing the filter: {wrong[0]}")
+    return 0 if wrong[0] == 0 else 1
+
+
+def hold(args):
+    from rsg_msgs.msg import RobotState  # noqa: the held subscriptions read the gateway's state
+    node = rclpy.create_node("rsg_bench_hold")
+    options = {}
+    if args.filter:
+        options["content_filter_options"] = ContentFilterOptions(filter_expression=args.filter, expression_parameters=[])
+    subscriptions = [node.create_subscription(RobotState, args.topic, lambda message: None, QoSProfile(depth=10), **options)
+                     for _ in range(args.count)]
+    say(f"holding {len(subscriptions)} subscriptions, content filter "
+        f"{all(s.is_cft_enabled for s in subscriptions) if args.filter else 'none'}")
+    time.sleep(args.seconds)
     return 0
 
 
@@ -238,11 +269,17 @@ def main():
     ch.add_argument("--count", type=int, default=50)
     ch.add_argument("--topic", default="robot_state")
     ch.add_argument("--hold", type=float, default=5)
+    ch.add_argument("--filter")
+    ho = commands.add_parser("hold")
+    ho.add_argument("--count", type=int, default=1)
+    ho.add_argument("--topic", default="/robot_state")
+    ho.add_argument("--filter")
+    ho.add_argument("--seconds", type=float, default=30)
     args = parser.parse_args()
 
     rclpy.init() if args.command != "churn" else None
     try:
-        return {"sub": subscribe, "pub": publish, "graph": graph, "churn": churn}[args.command](args)
+        return {"sub": subscribe, "pub": publish, "graph": graph, "churn": churn, "hold": hold}[args.command](args)
     finally:
         if args.command != "churn":
             rclpy.try_shutdown()

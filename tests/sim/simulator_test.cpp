@@ -246,7 +246,7 @@ TEST(SimReport, JsonHasEveryCounterAndCategory) {
   EXPECT_EQ(json["invalid"]["bad_value"], 1);
   EXPECT_EQ(json["invalid"].size(), wire::kErrorCategoryCount);
   for (const char* key : {"dropped", "duplicated", "reordered", "restarts", "pauses", "selection_requests",
-                          "invalid_requests", "send_failures"})
+                          "invalid_requests", "send_failures", "longest_gap_us"})
     EXPECT_EQ(json[key], 0) << key;
 }
 

@@ -65,7 +65,7 @@ Report (--report FILE, and a summary on stderr):
   {"sent","valid","dropped","duplicated","reordered",
    "invalid":{"truncated","length_mismatch","bad_crc","bad_request","reserved_bits",
               "selection_mismatch","bad_value"},
-   "restarts","pauses","selection_requests","invalid_requests","send_failures"}
+   "restarts","pauses","selection_requests","invalid_requests","send_failures","longest_gap_us"}
   sent = valid + all invalid (datagrams on the wire, a duplicate counted twice).)";
 
 bool parse_categories(const std::string& list, std::vector<rsg::wire::ErrorCategory>& out,

@@ -25,6 +25,7 @@ std::string SimReport::to_json() const {
       {"selection_requests", selection_requests},
       {"invalid_requests", invalid_requests},
       {"send_failures", send_failures},
+      {"longest_gap_us", longest_gap_us},
   };
   return report.dump();
 }

@@ -24,6 +24,9 @@ struct SimReport {
   std::uint64_t selection_requests = 0;  ///< valid requests applied
   std::uint64_t invalid_requests = 0;    ///< datagrams received that are no valid request
   std::uint64_t send_failures = 0;       ///< datagrams the kernel refused (not in `sent`)
+  /// The longest time between two datagrams the kernel accepted, µs: how long the "robot" was
+  /// really silent (its pauses, or a host too busy to run it on time).
+  std::uint64_t longest_gap_us = 0;
 
   std::uint64_t& invalid_count(wire::ErrorCategory category) {
     return invalid[static_cast<std::size_t>(category) - 1];

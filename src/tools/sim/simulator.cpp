@@ -1,5 +1,6 @@
 #include "simulator.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 
@@ -98,6 +99,13 @@ void Simulator::emit(const Datagram& datagram, DatagramSink& sink) {
     return;
   }
   ++report_.sent;
+  const auto now = std::chrono::steady_clock::now();
+  if (last_sent_)
+    report_.longest_gap_us = std::max<std::uint64_t>(
+        report_.longest_gap_us,
+        static_cast<std::uint64_t>(
+            std::chrono::duration_cast<std::chrono::microseconds>(now - *last_sent_).count()));
+  last_sent_ = now;
   if (datagram.category != wire::ErrorCategory::kNone) {
     ++report_.invalid_count(datagram.category);
     return;

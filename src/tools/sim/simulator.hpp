@@ -89,6 +89,7 @@ class Simulator {
   FaultPlan faults_;
   std::optional<wire::Selection> requested_;
   SimReport report_;
+  std::optional<std::chrono::steady_clock::time_point> last_sent_;  // for report_.longest_gap_us
 
   std::uint64_t frame_ = 0;       // frames produced since the start
   std::uint64_t boot_frame_ = 0;  // frame_ at the last (re)start

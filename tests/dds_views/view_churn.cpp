@@ -1,0 +1,90 @@
+// A client-library reader that comes and goes: for --seconds, ViewReaders on rotating views are
+// created, read until they got a sample carrying their groups (or --hold passes), and deleted;
+// every --participant-every cycles the participant goes too. Each sample a view reader takes
+// must carry the view's groups. Prints "cycles N samples M wrong W" and exits 1 when a view
+// received a sample without its groups, or 2 for usage errors.
+#include <RobotState.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "rsg/dds/participant.hpp"
+#include "rsg/dds/profiles.hpp"
+#include "rsg/dds/ros2.hpp"
+#include "rsg/dds/views.hpp"
+
+int main(int argc, char** argv) {
+  int domain = 0;
+  std::string topic_name = "robot_state";
+  std::vector<std::string> partitions;
+  bool ros2 = false;
+  double seconds = 10;
+  double hold = 1.0;
+  int participant_every = 10;
+  CLI::App app{"Creates and deletes view readers in a loop.", "rsg_views_churn"};
+  app.add_option("--domain", domain);
+  app.add_option("--topic", topic_name);
+  app.add_option("--partition", partitions);
+  app.add_flag("--ros2", ros2, "the ROS 2 names rsg_gateway --ros2 writes");
+  app.add_option("--seconds", seconds);
+  app.add_option("--hold", hold, "longest life of one reader, s");
+  app.add_option("--participant-every", participant_every)->check(CLI::PositiveNumber);
+  CLI11_PARSE(app, argc, argv);
+
+  namespace fdds = eprosima::fastdds::dds;
+  using Clock = std::chrono::steady_clock;
+  rsg::dds::load_profiles(rsg::dds::default_profiles_dir());
+  const std::string topic = ros2 ? rsg::dds::ros2_topic_name("", topic_name) : topic_name;
+  const std::string type = ros2 ? std::string(rsg::dds::kRos2RobotStateType) : "";
+  // Profiles and ad-hoc group views, each its own filtered topic.
+  const std::vector<std::string> profiles = {"view_joints", "view_kinematics", "view_forces", "view_full"};
+  const std::vector<std::uint8_t> ad_hoc = {0b000100, 0b101000, 0b000001};
+
+  const auto end =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  std::unique_ptr<rsg::dds::Participant> participant;
+  fdds::Subscriber* subscriber = nullptr;
+  std::size_t cycles = 0, samples = 0, wrong = 0;
+  rsg::RobotState sample;
+  fdds::SampleInfo info;
+  while (Clock::now() < end) {
+    if (cycles % static_cast<std::size_t>(participant_every) == 0) {
+      participant.reset();
+      participant = std::make_unique<rsg::dds::Participant>(domain, "");
+      subscriber = participant->subscriber(partitions);
+    }
+    fdds::Topic& robot_state = *participant->robot_state_topic(topic, type);
+    const std::size_t kinds = profiles.size() + ad_hoc.size();
+    const std::size_t pick = cycles % kinds;
+    std::unique_ptr<rsg::dds::ViewReader> reader =
+        pick < profiles.size()
+            ? std::make_unique<rsg::dds::ViewReader>(*subscriber, robot_state, profiles[pick],
+                                                     rsg::dds::kRealtimeReaderProfile)
+            : std::make_unique<rsg::dds::ViewReader>(
+                  *subscriber, robot_state, rsg::dds::group_view(ad_hoc[pick - profiles.size()]),
+                  rsg::dds::load_reader_qos(*subscriber, rsg::dds::kRealtimeReaderProfile));
+    const std::uint8_t groups = reader->view().groups;
+    const auto give_up =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(hold));
+    bool got = false;
+    while (!got && Clock::now() < give_up) {
+      (*reader)->wait_for_unread_message(rsg::dds::Duration(0, 20'000'000));
+      while ((*reader)->take_next_sample(&sample, &info) == rsg::dds::kOk) {
+        if (!info.valid_data) continue;
+        ++samples;
+        got = true;
+        if ((sample.group_select() & groups) != groups) ++wrong;
+      }
+    }
+    ++cycles;
+  }
+  std::printf("cycles %zu samples %zu wrong %zu\n", cycles, samples, wrong);
+  return wrong == 0 ? 0 : 1;
+}
