@@ -1,0 +1,167 @@
+"""Reader-kind benchmark: what N readers of each kind cost rsg_gateway at 1 kHz.
+
+    readers.py --bin BUILD/bin [--gateway PATH] [--label NAME] [--counts 0,1,4,16]
+               [--kinds plain,view,groups,ros2_filter] [--seconds 8] --out DIR
+
+Per point (kind, N): a fresh rsg_gateway --ros2 on a domain of its own, N readers of the kind,
+rsg_sim at 1 kHz with every frame carrying group 2 (so a view on group 2 takes what a plain reader
+takes), and a window of --seconds once both sides matched and the stream runs. Measured in that
+window from /proc: the gateway's CPU (percent of one core) and the readers' process CPU; from the
+gateway's stats file: frames published, its largest ingress delay (arrival at the socket to
+publication, per second) and any link-down report. Kinds:
+  plain        rsg_bench_reader_host --kind plain: N plain DataReaders in one process
+  view         ... --kind view: N ViewReaders on view_joints (the client library, as rsg_echo --view)
+  groups       ... --kind groups: N ad-hoc group views (rsg_echo --groups 2)
+  ros2_filter  one rclpy node with N subscriptions content-filtered with the DDS-SQL expression
+               docs/ros2.md recommends (rclpy_peer.py hold: it does not spin; its own cost is not
+               what is measured)
+  ros2_plain   the same without the filter (the control for ros2_filter)
+Writes DIR/readers_<label>.json and prints a table; ratios are within this one run. Timings only:
+no pass/fail.
+"""
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parents[1] / "integration"))
+sys.path.insert(0, str(HERE.parents[1] / "ros2"))
+from harness import free_udp_port, read_json, wait_for  # noqa: E402
+
+TICKS = os.sysconf("SC_CLK_TCK")
+ROS_FILTER = "group_present[2] = TRUE"
+
+
+def cpu_ticks(pid):
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return int(fields[11]) + int(fields[12])  # utime, stime
+
+
+def tree_ticks(pid):
+    """CPU ticks of `pid` and its children (the rclpy node runs under env/bash)."""
+    total = 0
+    try:
+        total = cpu_ticks(pid)
+        for child in Path(f"/proc/{pid}/task/{pid}/children").read_text().split():
+            total += tree_ticks(int(child))
+    except (FileNotFoundError, ProcessLookupError):
+        pass
+    return total
+
+
+def run_point(args, kind, count, domain, scratch):
+    port = free_udp_port()
+    stats = scratch / f"{kind}_{count}.stats.json"
+    log = open(scratch / f"{kind}_{count}.gateway.log", "w")
+    gateway = subprocess.Popen([args.gateway, "--listen", f"127.0.0.1:{port}", "--domain", str(domain), "--ros2",
+                                "--expected-rate", "1000", "--stats-file", str(stats)], stdout=log, stderr=log)
+    readers = None
+    sim = None
+    try:
+        wait_for(lambda: read_json(stats), "the gateway to start")
+        if count:
+            if kind.startswith("ros2"):
+                from rclpy_common import RosEnv
+                env = RosEnv(domain)
+                extra = ["--filter", ROS_FILTER] if kind == "ros2_filter" else []
+                readers = subprocess.Popen(env.argv("hold", "--count", count, "--seconds", 600, *extra),
+                                           stdout=subprocess.DEVNULL, stderr=open(scratch / f"{kind}_{count}.readers.err", "w"))
+            else:
+                readers = subprocess.Popen([str(Path(args.bin) / "rsg_bench_reader_host"), "--domain", str(domain), "--ros2",
+                                            "--kind", kind, "--count", str(count), "--settle", "600"],
+                                           stdout=subprocess.DEVNULL, stderr=open(scratch / f"{kind}_{count}.readers.err", "w"))
+            wait_for(lambda: (read_json(stats) or {}).get("state_readers", 0) >= count, f"{count} {kind} readers to match",
+                     timeout_s=60)
+        sim = subprocess.Popen([str(Path(args.bin) / "rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000",
+                                "--count", "100000000", "--every", "1:g2"], stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+        time.sleep(3)  # the stream settles; late discovery traffic ends
+        before = read_json(stats)
+        g0, r0, t0 = cpu_ticks(gateway.pid), tree_ticks(readers.pid) if readers else 0, time.monotonic()
+        delays = []
+        end = t0 + args.seconds
+        while time.monotonic() < end:
+            time.sleep(1.0)
+            current = read_json(stats)
+            if current:
+                delays.append(current["ingress_delay_us"])
+        g1, r1, t1 = cpu_ticks(gateway.pid), tree_ticks(readers.pid) if readers else 0, time.monotonic()
+        after = read_json(stats)
+        alive = gateway.poll() is None
+    finally:
+        for process in (sim, readers):
+            if process and process.poll() is None:
+                process.send_signal(signal.SIGTERM)
+                try:
+                    process.wait(timeout=10)
+                except subprocess.TimeoutExpired:
+                    process.kill()
+        if gateway.poll() is None:
+            gateway.send_signal(signal.SIGTERM)
+            gateway.wait(timeout=30)
+        log.close()
+    seconds = t1 - t0
+    gateway_log = (scratch / f"{kind}_{count}.gateway.log").read_text(errors="replace")
+    return {
+        "kind": kind, "readers": count, "seconds": round(seconds, 2), "gateway_alive": alive,
+        "gateway_cpu_pct": round(100.0 * (g1 - g0) / TICKS / seconds, 1),
+        "readers_cpu_pct": round(100.0 * (r1 - r0) / TICKS / seconds, 1),
+        "published_per_s": round((after["frames_published"] - before["frames_published"]) / seconds, 1),
+        "ingress_delay_max_us": max(delays) if delays else None,
+        "link_down_reports": gateway_log.count("link down"),
+    }
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--bin", required=True)
+    parser.add_argument("--gateway", help="rsg_gateway to measure (default: BIN/rsg_gateway)")
+    parser.add_argument("--label", default="fastdds2.9")
+    parser.add_argument("--counts", default="0,1,4,16")
+    parser.add_argument("--kinds", default="plain,view,groups,ros2_filter,ros2_plain")
+    parser.add_argument("--seconds", type=float, default=8)
+    parser.add_argument("--out", required=True)
+    args = parser.parse_args()
+    args.gateway = args.gateway or str(Path(args.bin) / "rsg_gateway")
+    counts = [int(c) for c in args.counts.split(",")]
+    kinds = args.kinds.split(",")
+    base_domain = 100 + os.getpid() % 80
+    points = []
+    with tempfile.TemporaryDirectory(prefix="rsg_bench_readers_") as tmp:
+        scratch = Path(tmp)
+        index = 0
+        for count in counts:
+            for kind in (kinds if count else kinds[:1]):
+                point = run_point(args, kind, count, base_domain + index % 20, scratch)
+                index += 1
+                points.append(point)
+                print(json.dumps(point), flush=True)
+    cpu_model = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
+    result = {"label": args.label, "cpu": cpu_model, "cores": os.cpu_count(), "gateway": args.gateway, "points": points}
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"readers_{args.label}.json").write_text(json.dumps(result, indent=2) + "\n")
+    print(table(result))
+
+
+def table(result):
+    by = {(p["kind"], p["readers"]): p for p in result["points"]}
+    lines = [f"### {result['label']} on {result['cpu']} ({result['cores']} cores)", "",
+             "| readers | kind | gateway CPU % | × plain | readers' CPU % | published/s | max ingress delay µs | link-down reports |",
+             "|---|---|---|---|---|---|---|---|"]
+    for p in result["points"]:
+        plain = by.get(("plain", p["readers"]))
+        ratio = f"{p['gateway_cpu_pct'] / plain['gateway_cpu_pct']:.2f}" if plain and plain["gateway_cpu_pct"] else "—"
+        lines.append(f"| {p['readers']} | {p['kind']} | {p['gateway_cpu_pct']} | {ratio} | {p['readers_cpu_pct']} | "
+                     f"{p['published_per_s']} | {p['ingress_delay_max_us']} | {p['link_down_reports']} |")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    main()
