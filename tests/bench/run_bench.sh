@@ -31,12 +31,17 @@
 #         and with Fast DDS's default announcement period (late_join.py): time to the first sample,
 #         bench/late_join/ (late_join.json, late_join.md). About 1.5 minutes.
 #         RSG_BENCH_LATE_JOIN_STARTS   starts per profile (default 100)
+#   readers  what 0, 1, 4 and 16 readers of each kind (plain, rsg view, ad-hoc groups, ROS 2 content
+#         filter, ROS 2 plain) cost rsg_gateway at 1 kHz (tests/bench/readers/readers.py): gateway and
+#         readers' CPU, frames published, largest ingress delay, link-down reports:
+#         bench/readers/readers_fastdds2.9.json. About 4 minutes.
+#         RSG_BENCH_READERS_SECONDS   measuring window per point (default 8)
 #
 # A suite is a function run_<suite> that writes its results under $out and a function
 # report_<suite> that prints them, plus its name in SUITES.
 set -euo pipefail
 
-SUITES=(wire e2e record scale late_join)
+SUITES=(wire e2e record scale late_join readers)
 
 here=$(cd "$(dirname "$0")" && pwd)
 usage() { echo "usage: $0 BUILD_DIR [${SUITES[*]}]" >&2; exit 2; }
@@ -144,6 +149,12 @@ run_late_join() {
   python3 "$here/late_join.py" --bin "$build/bin" --out "$out/late_join" --starts "${RSG_BENCH_LATE_JOIN_STARTS:-100}" >/dev/null
 }
 report_late_join() { cat "$out/late_join/late_join.md"; }
+
+run_readers() {
+  python3 "$here/readers/readers.py" --bin "$build/bin" --out "$out/readers" \
+    --seconds "${RSG_BENCH_READERS_SECONDS:-8}" > "$out/readers.txt"
+}
+report_readers() { sed -n '/^###/,$p' "$out/readers.txt"; }
 
 for suite in "${selected[@]}"; do
   declare -F "run_$suite" >/dev/null || { echo "$0: unknown suite '$suite'" >&2; usage; }

@@ -1,25 +1,42 @@
 #!/usr/bin/env bash
 # make bench-fastdds3: make bench's e2e suite on Fast DDS 2.9 (the host's build) and then on 3.x
 # (Debian 13's 3.1.2, the chroot's build of tools/fastdds3/chroot.sh), one right after the other on
-# one machine, and the two side by side (tests/bench/compare_fastdds.py). The committed runs and what
-# they say: docs/benchmarks/fastdds3/.
+# one machine, and the two side by side (tests/bench/compare_fastdds.py); then the readers suite
+# (tests/bench/readers/readers.py) with a 2.9 gateway and with a 3.1.2 gateway (the readers run on
+# the host in both). The committed runs and what they say: docs/benchmarks/fastdds3/.
 #
-#   tests/fastdds3/bench.sh [HOST_BUILD]     HOST_BUILD: the host's 2.9 build tree (default build)
+#   tests/fastdds3/bench.sh [HOST_BUILD [SUITE...]]   HOST_BUILD: the host's 2.9 build tree (default
+#                                                     build); SUITE: e2e, readers (default both)
 #
 # The RSG_BENCH_E2E_* durations of tests/bench/run_bench.sh apply to both runs.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 host_build=${1:-build}
+shift || true
+suites=("${@:-e2e readers}")
+suites=(${suites[*]})
 build=${RSG_FASTDDS3_BUILD:-build-fdds3}
 chroot=tools/fastdds3/chroot.sh
-targets=(rsg_bench_e2e rsg_bench_relay_cyclone rsg_bench_cyclone_reader)
+targets=(rsg_bench_e2e rsg_bench_relay_cyclone rsg_bench_cyclone_reader rsg_gateway)
 
 $chroot setup
 [[ -f $build/CMakeCache.txt ]] ||
   $chroot in cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRSG_FASTDDS=3 \
     -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache > /dev/null
 $chroot in cmake --build "$build" -j "${JOBS:-$(nproc)}" --target "${targets[@]}"
-cmake --build "$host_build" -j "${JOBS:-$(nproc)}" --target "${targets[@]}"
+cmake --build "$host_build" -j "${JOBS:-$(nproc)}" --target "${targets[@]}" rsg_sim rsg_bench_reader_host
+
+if [[ " ${suites[*]} " == *" readers "* ]]; then
+  # The 3.x gateway is a script that runs the chroot's build; readers.py counts its process tree.
+  wrapper=$build/bench/rsg_gateway_3
+  mkdir -p "$build/bench"
+  printf '#!/bin/sh\nexec %s in %s "$@"\n' "$PWD/$chroot" "$PWD/$build/bin/rsg_gateway" > "$wrapper"
+  chmod +x "$wrapper"
+  python3 tests/bench/readers/readers.py --bin "$host_build/bin" --label fastdds2.9 --out "$build/bench/readers"
+  python3 tests/bench/readers/readers.py --bin "$host_build/bin" --gateway "$wrapper" --label fastdds3.1.2 \
+    --out "$build/bench/readers"
+fi
+[[ " ${suites[*]} " == *" e2e "* ]] || exit 0
 
 tests/bench/run_bench.sh "$host_build" e2e > /dev/null
 # The chroot starts from an empty environment: the durations and the commit (no git in there) go in.

@@ -8,7 +8,8 @@ rsg_sim at 1 kHz with every frame carrying group 2 (so a view on group 2 takes w
 takes), and a window of --seconds once both sides matched and the stream runs. Measured in that
 window from /proc: the gateway's CPU (percent of one core) and the readers' process CPU; from the
 gateway's stats file: frames published, its largest ingress delay (arrival at the socket to
-publication, per second) and any link-down report. Kinds:
+publication, per second) and the link-down reports it logged in the window. --gateway may be a
+wrapper script (the Fast DDS 3 chroot's): CPU is counted over its process tree. Kinds:
   plain        rsg_bench_reader_host --kind plain: N plain DataReaders in one process
   view         ... --kind view: N ViewReaders on view_joints (the client library, as rsg_echo --view)
   groups       ... --kind groups: N ad-hoc group views (rsg_echo --groups 2)
@@ -55,6 +56,11 @@ def tree_ticks(pid):
     return total
 
 
+def realtime_prefix():
+    probe = subprocess.run(["chrt", "-f", "20", "true"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return ["chrt", "-f", "20"] if probe.returncode == 0 else []
+
+
 def run_point(args, kind, count, domain, scratch):
     port = free_udp_port()
     stats = scratch / f"{kind}_{count}.stats.json"
@@ -78,22 +84,30 @@ def run_point(args, kind, count, domain, scratch):
                                            stdout=subprocess.DEVNULL, stderr=open(scratch / f"{kind}_{count}.readers.err", "w"))
             wait_for(lambda: (read_json(stats) or {}).get("state_readers", 0) >= count, f"{count} {kind} readers to match",
                      timeout_s=60)
-        sim = subprocess.Popen([str(Path(args.bin) / "rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000",
-                                "--count", "100000000", "--every", "1:g2"], stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
+        # As a robot streams: on time (SCHED_FIFO where allowed); its report says how long it really
+        # went silent, which is what a link-down report must be judged against.
+        sim_report = scratch / f"{kind}_{count}.sim.json"
+        sim = subprocess.Popen([*realtime_prefix(), str(Path(args.bin) / "rsg_sim"), "--to", f"127.0.0.1:{port}",
+                                "--rate", "1000", "--duration", str(args.seconds + 5), "--report", str(sim_report),
+                                "--every", "1:g2"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         time.sleep(3)  # the stream settles; late discovery traffic ends
         before = read_json(stats)
-        g0, r0, t0 = cpu_ticks(gateway.pid), tree_ticks(readers.pid) if readers else 0, time.monotonic()
+        gateway_log = scratch / f"{kind}_{count}.gateway.log"
+        downs0 = gateway_log.read_text(errors="replace").count("] link down")
+        g0, r0, t0 = tree_ticks(gateway.pid), tree_ticks(readers.pid) if readers else 0, time.monotonic()
         delays = []
         end = t0 + args.seconds
         while time.monotonic() < end:
             time.sleep(1.0)
             current = read_json(stats)
             if current:
-                delays.append(current["ingress_delay_us"])
-        g1, r1, t1 = cpu_ticks(gateway.pid), tree_ticks(readers.pid) if readers else 0, time.monotonic()
+                delays.append(current.get("ingress_delay_us", 0))
+        g1, r1, t1 = tree_ticks(gateway.pid), tree_ticks(readers.pid) if readers else 0, time.monotonic()
+        downs = gateway_log.read_text(errors="replace").count("] link down") - downs0
         after = read_json(stats)
         alive = gateway.poll() is None
+        sim.wait(timeout=30)
+        robot_silence_us = (read_json(sim_report) or {}).get("longest_gap_us")
     finally:
         for process in (sim, readers):
             if process and process.poll() is None:
@@ -107,14 +121,14 @@ def run_point(args, kind, count, domain, scratch):
             gateway.wait(timeout=30)
         log.close()
     seconds = t1 - t0
-    gateway_log = (scratch / f"{kind}_{count}.gateway.log").read_text(errors="replace")
     return {
         "kind": kind, "readers": count, "seconds": round(seconds, 2), "gateway_alive": alive,
         "gateway_cpu_pct": round(100.0 * (g1 - g0) / TICKS / seconds, 1),
         "readers_cpu_pct": round(100.0 * (r1 - r0) / TICKS / seconds, 1),
         "published_per_s": round((after["frames_published"] - before["frames_published"]) / seconds, 1),
         "ingress_delay_max_us": max(delays) if delays else None,
-        "link_down_reports": gateway_log.count("link down"),
+        "link_down_reports": downs,
+        "robot_longest_silence_us": robot_silence_us,
     }
 
 
@@ -153,13 +167,14 @@ def main():
 def table(result):
     by = {(p["kind"], p["readers"]): p for p in result["points"]}
     lines = [f"### {result['label']} on {result['cpu']} ({result['cores']} cores)", "",
-             "| readers | kind | gateway CPU % | × plain | readers' CPU % | published/s | max ingress delay µs | link-down reports |",
-             "|---|---|---|---|---|---|---|---|"]
+             "| readers | kind | gateway CPU % | × plain | readers' CPU % | published/s | max ingress delay µs | link-down reports | robot's longest silence µs |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for p in result["points"]:
         plain = by.get(("plain", p["readers"]))
         ratio = f"{p['gateway_cpu_pct'] / plain['gateway_cpu_pct']:.2f}" if plain and plain["gateway_cpu_pct"] else "—"
         lines.append(f"| {p['readers']} | {p['kind']} | {p['gateway_cpu_pct']} | {ratio} | {p['readers_cpu_pct']} | "
-                     f"{p['published_per_s']} | {p['ingress_delay_max_us']} | {p['link_down_reports']} |")
+                     f"{p['published_per_s']} | {p['ingress_delay_max_us']} | {p['link_down_reports']} | "
+                     f"{p['robot_longest_silence_us']} |")
     return "\n".join(lines)
 
 
