@@ -70,9 +70,9 @@ class GroupFilterFactory final : public fdds::IContentFilterFactory {
       filters_[mask].set_groups(static_cast<std::uint8_t>(mask));
   }
 
-  ReturnCode_t create_content_filter(const char*, const char*, const fdds::TopicDataType*,
-                                     const char* expression, const ParameterSeq& parameters,
-                                     fdds::IContentFilter*& filter) override {
+  ReturnCode create_content_filter(const char*, const char*, const fdds::TopicDataType*,
+                                   const char* expression, const ParameterSeq& parameters,
+                                   fdds::IContentFilter*& filter) override {
     // A null expression means "new parameters, same expression": these filters take none.
     if (expression == nullptr) return filter != nullptr && parameters.length() == 0 ? kOk : kBadParameter;
     const wire::Parsed<std::uint8_t> groups = parse_group_filter_expression(expression);
@@ -81,7 +81,7 @@ class GroupFilterFactory final : public fdds::IContentFilterFactory {
     return kOk;
   }
 
-  ReturnCode_t delete_content_filter(const char*, fdds::IContentFilter*) override { return kOk; }
+  ReturnCode delete_content_filter(const char*, fdds::IContentFilter*) override { return kOk; }
 
  private:
   std::array<GroupFilter, kValidGroupBits + 1> filters_;
