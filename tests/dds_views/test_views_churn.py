@@ -18,6 +18,7 @@ run and must print exactly the frames carrying their groups. The cycle counts an
 longest ingress delay are printed, not judged (timings belong in make bench).
 """
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -80,8 +81,12 @@ def body(h):
     wait_for_stats(stats, lambda s: s["frames_published"] >= 500 and s["link_up"], "the stream to start")
     stop_at = time.monotonic() + CHURN_S
 
+    # reader_realtime: data-sharing on this host, the common case; reader_realtime_udp where the gateway
+    # is another Fast DDS version (2.9 and 3.x data-sharing on one host abort the writer:
+    # docs/fastdds-versions.md), which tests/fastdds3/run.sh asks for.
+    qos = "reader_realtime_udp" if os.environ.get("RSG_CHURN_UDP_READERS") else "reader_realtime"
     library = h.start("library", [h.binary("rsg_views_churn"), *domain, "--ros2", "--seconds", str(CHURN_S),
-                                  "--hold", "0.5", "--participant-every", "5"])
+                                  "--hold", "0.5", "--participant-every", "5", "--qos", qos])
     counts = {"echo": [0], "rclpy_process": [0]}
     rclpy_loop = start_peer(h, env, "rclpy_loop", "churn", "--count", 12, "--topic", "/robot_state", "--hold", 1,
                             "--filter", ROS_FILTER)

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   double seconds = 10;
   double hold = 1.0;
   int participant_every = 10;
+  std::string qos_profile = rsg::dds::kRealtimeReaderProfile;
   CLI::App app{"Creates and deletes view readers in a loop.", "rsg_views_churn"};
   app.add_option("--domain", domain);
   app.add_option("--topic", topic_name);
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
   app.add_option("--seconds", seconds);
   app.add_option("--hold", hold, "longest life of one reader, s");
   app.add_option("--participant-every", participant_every)->check(CLI::PositiveNumber);
+  app.add_option("--qos", qos_profile, "reader QoS profile");
   CLI11_PARSE(app, argc, argv);
 
   namespace fdds = eprosima::fastdds::dds;
@@ -65,11 +67,10 @@ int main(int argc, char** argv) {
     const std::size_t pick = cycles % kinds;
     std::unique_ptr<rsg::dds::ViewReader> reader =
         pick < profiles.size()
-            ? std::make_unique<rsg::dds::ViewReader>(*subscriber, robot_state, profiles[pick],
-                                                     rsg::dds::kRealtimeReaderProfile)
-            : std::make_unique<rsg::dds::ViewReader>(
-                  *subscriber, robot_state, rsg::dds::group_view(ad_hoc[pick - profiles.size()]),
-                  rsg::dds::load_reader_qos(*subscriber, rsg::dds::kRealtimeReaderProfile));
+            ? std::make_unique<rsg::dds::ViewReader>(*subscriber, robot_state, profiles[pick], qos_profile)
+            : std::make_unique<rsg::dds::ViewReader>(*subscriber, robot_state,
+                                                     rsg::dds::group_view(ad_hoc[pick - profiles.size()]),
+                                                     rsg::dds::load_reader_qos(*subscriber, qos_profile));
     const std::uint8_t groups = reader->view().groups;
     const auto give_up =
         Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(hold));
