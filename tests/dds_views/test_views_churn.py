@@ -36,6 +36,9 @@ CHURN_S = 40
 FINAL_COUNT = 2000
 STREAM = ["--every", "1:g2", "--every", "3:g3", "--every", "10:g0,g5", "--every", "50:all"]
 ROS_FILTER = "group_present[2] = TRUE AND group_present[3] = TRUE"
+# RSG_CHURN_CONTROL=1: the same churn with plain readers only, the control for the stall figures
+# (docs/benchmarks/views_churn.md); the final checks are the same.
+CONTROL = bool(os.environ.get("RSG_CHURN_CONTROL"))
 ECHO_VIEWS = [["--view", "view_kinematics"], ["--groups", "2,3"], ["--view", "view_joints"], ["--view", "view_forces"]]
 
 
@@ -86,21 +89,22 @@ def body(h):
     # docs/fastdds-versions.md), which tests/fastdds3/run.sh asks for.
     qos = "reader_realtime_udp" if os.environ.get("RSG_CHURN_UDP_READERS") else "reader_realtime"
     library = h.start("library", [h.binary("rsg_views_churn"), *domain, "--ros2", "--seconds", str(CHURN_S),
-                                  "--hold", "0.5", "--participant-every", "5", "--qos", qos])
+                                  "--hold", "0.5", "--participant-every", "5", "--qos", qos,
+                                  *(["--plain"] if CONTROL else [])])
     counts = {"echo": [0], "rclpy_process": [0]}
     rclpy_loop = start_peer(h, env, "rclpy_loop", "churn", "--count", 12, "--topic", "/robot_state", "--hold", 1,
-                            "--filter", ROS_FILTER)
+                            *([] if CONTROL else ["--filter", ROS_FILTER]))
 
     def echo_step(index):
-        process = h.start(f"echo{index}", [echo, *domain, "--ros2", *ECHO_VIEWS[index % len(ECHO_VIEWS)],
-                                           "--json", "--timeout", "30"])
+        view = [] if CONTROL else ECHO_VIEWS[index % len(ECHO_VIEWS)]
+        process = h.start(f"echo{index}", [echo, *domain, "--ros2", *view, "--json", "--timeout", "30"])
         time.sleep(0.4 + 0.2 * (index % 3))
         stop_child(process, index)
 
     def rclpy_step(index):
         label = f"rclpy{index}"
-        process = start_peer(h, env, label, "sub", "/robot_state", "rsg_msgs/msg/RobotState", "--filter", ROS_FILTER,
-                             "--timeout", 30)
+        process = start_peer(h, env, label, "sub", "/robot_state", "rsg_msgs/msg/RobotState",
+                             *([] if CONTROL else ["--filter", ROS_FILTER]), "--timeout", 30)
         err = h.dir / f"{label}.err"
         deadline = time.monotonic() + 8
         while time.monotonic() < deadline and not (err.exists() and "matched 1" in err.read_text(errors="replace")):

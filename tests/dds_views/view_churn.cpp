@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "rsg/dds/detail/fastdds_compat.hpp"
+#include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/ros2.hpp"
@@ -29,6 +30,7 @@ int main(int argc, char** argv) {
   double hold = 1.0;
   int participant_every = 10;
   std::string qos_profile = rsg::dds::kRealtimeReaderProfile;
+  bool plain = false;
   CLI::App app{"Creates and deletes view readers in a loop.", "rsg_views_churn"};
   app.add_option("--domain", domain);
   app.add_option("--topic", topic_name);
@@ -38,6 +40,7 @@ int main(int argc, char** argv) {
   app.add_option("--hold", hold, "longest life of one reader, s");
   app.add_option("--participant-every", participant_every)->check(CLI::PositiveNumber);
   app.add_option("--qos", qos_profile, "reader QoS profile");
+  app.add_flag("--plain", plain, "plain readers instead of views (the control)");
   CLI11_PARSE(app, argc, argv);
 
   namespace fdds = eprosima::fastdds::dds;
@@ -65,19 +68,29 @@ int main(int argc, char** argv) {
     fdds::Topic& robot_state = *participant->robot_state_topic(topic, type);
     const std::size_t kinds = profiles.size() + ad_hoc.size();
     const std::size_t pick = cycles % kinds;
-    std::unique_ptr<rsg::dds::ViewReader> reader =
-        pick < profiles.size()
-            ? std::make_unique<rsg::dds::ViewReader>(*subscriber, robot_state, profiles[pick], qos_profile)
-            : std::make_unique<rsg::dds::ViewReader>(*subscriber, robot_state,
-                                                     rsg::dds::group_view(ad_hoc[pick - profiles.size()]),
-                                                     rsg::dds::load_reader_qos(*subscriber, qos_profile));
-    const std::uint8_t groups = reader->view().groups;
+    std::unique_ptr<rsg::dds::ViewReader> view;
+    rsg::dds::OwnedReader plain_reader;
+    if (plain) {
+      plain_reader = rsg::dds::own(
+          *subscriber,
+          subscriber->create_datareader(&robot_state, rsg::dds::load_reader_qos(*subscriber, qos_profile)),
+          "a plain reader");
+    } else {
+      view =
+          pick < profiles.size()
+              ? std::make_unique<rsg::dds::ViewReader>(*subscriber, robot_state, profiles[pick], qos_profile)
+              : std::make_unique<rsg::dds::ViewReader>(*subscriber, robot_state,
+                                                       rsg::dds::group_view(ad_hoc[pick - profiles.size()]),
+                                                       rsg::dds::load_reader_qos(*subscriber, qos_profile));
+    }
+    fdds::DataReader* reader = plain ? plain_reader.get() : view->get();
+    const std::uint8_t groups = plain ? 0 : view->view().groups;
     const auto give_up =
         Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(hold));
     bool got = false;
     while (!got && Clock::now() < give_up) {
-      (*reader)->wait_for_unread_message(rsg::dds::Duration(0, 20'000'000));
-      while ((*reader)->take_next_sample(&sample, &info) == rsg::dds::kOk) {
+      reader->wait_for_unread_message(rsg::dds::Duration(0, 20'000'000));
+      while (reader->take_next_sample(&sample, &info) == rsg::dds::kOk) {
         if (!info.valid_data) continue;
         ++samples;
         got = true;
