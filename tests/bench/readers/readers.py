@@ -3,10 +3,13 @@
     readers.py --bin BUILD/bin [--gateway PATH] [--label NAME] [--counts 0,1,4,16]
                [--kinds plain,view,groups,ros2_filter] [--seconds 8] --out DIR
 
-Per point (kind, N): a fresh rsg_gateway --ros2 on a domain of its own, N readers of the kind,
-rsg_sim at 1 kHz with every frame carrying group 2 (so a view on group 2 takes what a plain reader
-takes), and a window of --seconds once both sides matched and the stream runs. Measured in that
-window from /proc: the gateway's CPU (percent of one core) and the readers' process CPU; from the
+Per point (kind, N): a fresh rsg_gateway --ros2 on a domain of its own, N readers of the kind, a
+1 kHz stream whose every frame carries group 2 (so a view on group 2 takes what a plain reader
+takes), and a window of --seconds once both sides matched and the stream runs. For rsg's readers
+the reader process is also the robot, sending stamped full frames, and measures the one-way
+latency robot -> gateway -> reader (p50/p99 over all its readers); for the ROS 2 kinds and for no
+reader, rsg_sim streams. Measured in that window from /proc: the gateway's CPU (percent of one
+core) and the readers' process CPU; from the
 gateway's stats file: frames published, its largest ingress delay (arrival at the socket to
 publication, per second) and the link-down reports it logged in the window. --gateway may be a
 wrapper script (the Fast DDS 3 chroot's): CPU is counted over its process tree. Kinds:
@@ -64,41 +67,49 @@ def realtime_prefix():
 def run_point(args, kind, count, domain, scratch):
     port = free_udp_port()
     stats = scratch / f"{kind}_{count}.stats.json"
-    log = open(scratch / f"{kind}_{count}.gateway.log", "w")
+    gateway_log = scratch / f"{kind}_{count}.gateway.log"
+    log = open(gateway_log, "w")
     gateway = subprocess.Popen([args.gateway, "--listen", f"127.0.0.1:{port}", "--domain", str(domain), "--ros2",
                                 "--expected-rate", "1000", "--stats-file", str(stats)], stdout=log, stderr=log)
     readers = None
     sim = None
+    host_result = None
+    robot_silence_us = None
+    # rsg's own readers: rsg_bench_reader_host is also the robot (stamped frames, so it measures the
+    # latency). Otherwise rsg_sim is, on time (SCHED_FIFO where allowed).
+    host = count and not kind.startswith("ros2")
+    readers_err = scratch / f"{kind}_{count}.readers.err"
     try:
         wait_for(lambda: read_json(stats), "the gateway to start")
+        if host:
+            readers = subprocess.Popen([str(Path(args.bin) / "rsg_bench_reader_host"),
+                                        "--domain", str(domain), "--ros2", "--kind", kind, "--count", str(count),
+                                        "--send-to", f"127.0.0.1:{port}", "--settle", "3", "--seconds", str(args.seconds)],
+                                       stdout=subprocess.PIPE, stderr=open(readers_err, "w"), text=True)
+        elif count:
+            from rclpy_common import RosEnv
+            env = RosEnv(domain)
+            extra = ["--filter", ROS_FILTER] if kind == "ros2_filter" else []
+            readers = subprocess.Popen(env.argv("hold", "--count", count, "--seconds", 600, *extra),
+                                       stdout=subprocess.DEVNULL, stderr=open(readers_err, "w"))
         if count:
-            if kind.startswith("ros2"):
-                from rclpy_common import RosEnv
-                env = RosEnv(domain)
-                extra = ["--filter", ROS_FILTER] if kind == "ros2_filter" else []
-                readers = subprocess.Popen(env.argv("hold", "--count", count, "--seconds", 600, *extra),
-                                           stdout=subprocess.DEVNULL, stderr=open(scratch / f"{kind}_{count}.readers.err", "w"))
-            else:
-                readers = subprocess.Popen([str(Path(args.bin) / "rsg_bench_reader_host"), "--domain", str(domain), "--ros2",
-                                            "--kind", kind, "--count", str(count), "--settle", "600"],
-                                           stdout=subprocess.DEVNULL, stderr=open(scratch / f"{kind}_{count}.readers.err", "w"))
             wait_for(lambda: (read_json(stats) or {}).get("state_readers", 0) >= count, f"{count} {kind} readers to match",
                      timeout_s=60)
-        # As a robot streams: on time (SCHED_FIFO where allowed); its report says how long it really
-        # went silent, which is what a link-down report must be judged against.
-        sim_report = scratch / f"{kind}_{count}.sim.json"
-        sim = subprocess.Popen([*realtime_prefix(), str(Path(args.bin) / "rsg_sim"), "--to", f"127.0.0.1:{port}",
-                                "--rate", "1000", "--duration", str(args.seconds + 5), "--report", str(sim_report),
-                                "--every", "1:g2"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        time.sleep(3)  # the stream settles; late discovery traffic ends
+        if host:
+            wait_for(lambda: "window start" in readers_err.read_text(), "the reader host's window", timeout_s=60)
+        else:
+            sim_report = scratch / f"{kind}_{count}.sim.json"
+            sim = subprocess.Popen([*realtime_prefix(), str(Path(args.bin) / "rsg_sim"), "--to", f"127.0.0.1:{port}",
+                                    "--rate", "1000", "--duration", str(args.seconds + 5), "--report", str(sim_report),
+                                    "--every", "1:g2"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            time.sleep(3)  # the stream settles; late discovery traffic ends
         before = read_json(stats)
-        gateway_log = scratch / f"{kind}_{count}.gateway.log"
         downs0 = gateway_log.read_text(errors="replace").count("] link down")
         g0, r0, t0 = tree_ticks(gateway.pid), tree_ticks(readers.pid) if readers else 0, time.monotonic()
         delays = []
         end = t0 + args.seconds
         while time.monotonic() < end:
-            time.sleep(1.0)
+            time.sleep(min(1.0, max(0.0, end - time.monotonic())))
             current = read_json(stats)
             if current:
                 delays.append(current.get("ingress_delay_us", 0))
@@ -106,8 +117,13 @@ def run_point(args, kind, count, domain, scratch):
         downs = gateway_log.read_text(errors="replace").count("] link down") - downs0
         after = read_json(stats)
         alive = gateway.poll() is None
-        sim.wait(timeout=30)
-        robot_silence_us = (read_json(sim_report) or {}).get("longest_gap_us")
+        if host:
+            out, _ = readers.communicate(timeout=60)
+            host_result = json.loads(out.strip().splitlines()[-1])
+            robot_silence_us = host_result["sender_longest_gap_us"]
+        else:
+            sim.wait(timeout=30)
+            robot_silence_us = (read_json(sim_report) or {}).get("longest_gap_us")
     finally:
         for process in (sim, readers):
             if process and process.poll() is None:
@@ -126,6 +142,9 @@ def run_point(args, kind, count, domain, scratch):
         "gateway_cpu_pct": round(100.0 * (g1 - g0) / TICKS / seconds, 1),
         "readers_cpu_pct": round(100.0 * (r1 - r0) / TICKS / seconds, 1),
         "published_per_s": round((after["frames_published"] - before["frames_published"]) / seconds, 1),
+        "latency_p50_us": host_result["latency_p50_us"] if host_result else None,
+        "latency_p99_us": host_result["latency_p99_us"] if host_result else None,
+        "wrong_samples": host_result["wrong"] if host_result else None,
         "ingress_delay_max_us": max(delays) if delays else None,
         "link_down_reports": downs,
         "robot_longest_silence_us": robot_silence_us,
@@ -167,13 +186,14 @@ def main():
 def table(result):
     by = {(p["kind"], p["readers"]): p for p in result["points"]}
     lines = [f"### {result['label']} on {result['cpu']} ({result['cores']} cores)", "",
-             "| readers | kind | gateway CPU % | × plain | readers' CPU % | published/s | max ingress delay µs | link-down reports | robot's longest silence µs |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "| readers | kind | gateway CPU % | × plain | readers' CPU % | published/s | p50 µs | p99 µs | max ingress delay µs | link-down reports | robot's longest silence µs |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for p in result["points"]:
         plain = by.get(("plain", p["readers"]))
         ratio = f"{p['gateway_cpu_pct'] / plain['gateway_cpu_pct']:.2f}" if plain and plain["gateway_cpu_pct"] else "—"
         lines.append(f"| {p['readers']} | {p['kind']} | {p['gateway_cpu_pct']} | {ratio} | {p['readers_cpu_pct']} | "
-                     f"{p['published_per_s']} | {p['ingress_delay_max_us']} | {p['link_down_reports']} | "
+                     f"{p['published_per_s']} | {p['latency_p50_us'] or '—'} | {p['latency_p99_us'] or '—'} | "
+                     f"{p['ingress_delay_max_us']} | {p['link_down_reports']} | "
                      f"{p['robot_longest_silence_us']} |")
     return "\n".join(lines)
 
