@@ -34,7 +34,7 @@ if [[ " ${suites[*]} " == *" readers "* ]]; then
   chmod +x "$wrapper"
   python3 tests/bench/readers/readers.py --bin "$host_build/bin" --label fastdds2.9 --out "$build/bench/readers"
   python3 tests/bench/readers/readers.py --bin "$host_build/bin" --gateway "$wrapper" --label fastdds3.1.2 \
-    --out "$build/bench/readers"
+    --reader-qos reader_realtime_udp --out "$build/bench/readers"
 fi
 [[ " ${suites[*]} " == *" e2e "* ]] || exit 0
 

@@ -122,6 +122,7 @@ int main(int argc, char** argv) {
   double rate_hz = 1000;
   std::string send_to;
   bool ros2 = false;
+  std::string qos_profile = rsg::dds::kRealtimeReaderProfile;
   CLI::App app{"Holds N readers of one kind and counts what they take.", "rsg_bench_reader_host"};
   app.add_option("--domain", domain);
   app.add_option("--kind", kind)->check(CLI::IsMember({"plain", "view", "groups"}));
@@ -131,6 +132,7 @@ int main(int argc, char** argv) {
   app.add_option("--send-to", send_to, "the gateway's HOST:PORT: be the robot, with stamped frames");
   app.add_option("--rate", rate_hz, "frames per second with --send-to");
   app.add_flag("--ros2", ros2);
+  app.add_option("--qos", qos_profile, "reader QoS profile (reader_realtime: data-sharing on this host)");
   CLI11_PARSE(app, argc, argv);
 
   rsg::dds::load_profiles(rsg::dds::default_profiles_dir());
@@ -144,7 +146,7 @@ int main(int argc, char** argv) {
   std::vector<rsg::dds::OwnedReader> plain;
   std::vector<std::unique_ptr<rsg::dds::ViewReader>> views;
   std::vector<fdds::DataReader*> readers;
-  const fdds::DataReaderQos qos = rsg::dds::load_reader_qos(subscriber, rsg::dds::kRealtimeReaderProfile);
+  const fdds::DataReaderQos qos = rsg::dds::load_reader_qos(subscriber, qos_profile);
   for (int i = 0; i < count; ++i) {
     takers.push_back(std::make_unique<Taker>(groups));
     if (kind == "plain") {

@@ -84,7 +84,8 @@ def run_point(args, kind, count, domain, scratch):
         if host:
             readers = subprocess.Popen([str(Path(args.bin) / "rsg_bench_reader_host"),
                                         "--domain", str(domain), "--ros2", "--kind", kind, "--count", str(count),
-                                        "--send-to", f"127.0.0.1:{port}", "--settle", "3", "--seconds", str(args.seconds)],
+                                        "--send-to", f"127.0.0.1:{port}", "--settle", "3", "--seconds", str(args.seconds),
+                                        "--qos", args.reader_qos],
                                        stdout=subprocess.PIPE, stderr=open(readers_err, "w"), text=True)
         elif count:
             from rclpy_common import RosEnv
@@ -160,6 +161,9 @@ def main():
     parser.add_argument("--kinds", default="plain,view,groups,ros2_filter,ros2_plain")
     parser.add_argument("--seconds", type=float, default=8)
     parser.add_argument("--out", required=True)
+    parser.add_argument("--reader-qos", default="reader_realtime",
+                        help="rsg readers' profile: reader_realtime (data-sharing on this host) or reader_realtime_udp "
+                             "(a gateway of another Fast DDS version: 2.9/3.x data-sharing aborts the writer)")
     args = parser.parse_args()
     args.gateway = args.gateway or str(Path(args.bin) / "rsg_gateway")
     counts = [int(c) for c in args.counts.split(",")]
@@ -176,7 +180,8 @@ def main():
                 points.append(point)
                 print(json.dumps(point), flush=True)
     cpu_model = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
-    result = {"label": args.label, "cpu": cpu_model, "cores": os.cpu_count(), "gateway": args.gateway, "points": points}
+    result = {"label": args.label, "cpu": cpu_model, "cores": os.cpu_count(), "gateway": args.gateway,
+              "reader_qos": args.reader_qos, "points": points}
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / f"readers_{args.label}.json").write_text(json.dumps(result, indent=2) + "\n")
@@ -185,7 +190,7 @@ def main():
 
 def table(result):
     by = {(p["kind"], p["readers"]): p for p in result["points"]}
-    lines = [f"### {result['label']} on {result['cpu']} ({result['cores']} cores)", "",
+    lines = [f"### {result['label']} on {result['cpu']} ({result['cores']} cores), rsg readers: {result['reader_qos']}", "",
              "| readers | kind | gateway CPU % | × plain | readers' CPU % | published/s | p50 µs | p99 µs | max ingress delay µs | link-down reports | robot's longest silence µs |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for p in result["points"]:
