@@ -16,7 +16,7 @@ project's ROS 2 environment (ros2/env.sh), never imported by the tests themselve
       N times: rclpy.init (a new DDS participant), a node with a default-QoS RobotState
       subscription (content-filtered with --filter), wait for its match and one message (at most
       --hold s), shut down; with --filter every message must pass it (group_present terms only)
-  hold --count N [--filter EXPR] --seconds S
+  hold --count N [--filter EXPR] [--best-effort] --seconds S
       N RobotState subscriptions (default QoS, content-filtered with --filter) held for S seconds
       without spinning: what a gateway pays for N such readers (make bench's readers suite); the
       node's own cost is not what it measures
@@ -232,7 +232,8 @@ def hold(args):
     options = {}
     if args.filter:
         options["content_filter_options"] = ContentFilterOptions(filter_expression=args.filter, expression_parameters=[])
-    subscriptions = [node.create_subscription(RobotState, args.topic, lambda message: None, QoSProfile(depth=10), **options)
+    qos = qos_profile_sensor_data if args.best_effort else QoSProfile(depth=10)
+    subscriptions = [node.create_subscription(RobotState, args.topic, lambda message: None, qos, **options)
                      for _ in range(args.count)]
     say(f"holding {len(subscriptions)} subscriptions, content filter "
         f"{all(s.is_cft_enabled for s in subscriptions) if args.filter else 'none'}")
@@ -275,6 +276,7 @@ def main():
     ho.add_argument("--topic", default="/robot_state")
     ho.add_argument("--filter")
     ho.add_argument("--seconds", type=float, default=30)
+    ho.add_argument("--best-effort", action="store_true", help="sensor_data QoS instead of the default (reliable)")
     args = parser.parse_args()
 
     rclpy.init() if args.command != "churn" else None

@@ -20,6 +20,8 @@ wrapper script (the Fast DDS 3 chroot's): CPU is counted over its process tree. 
                docs/ros2.md recommends (rclpy_peer.py hold: it does not spin; its own cost is not
                what is measured)
   ros2_plain   the same without the filter (the control for ros2_filter)
+  ros2_filter_best_effort  ros2_filter with best-effort subscriptions (sensor_data QoS): no repairs,
+               so what is left is what the filters cost the gateway (nothing: it evaluates none)
 Writes DIR/readers_<label>.json and prints a table; ratios are within this one run. Timings only:
 no pass/fail.
 """
@@ -90,7 +92,8 @@ def run_point(args, kind, count, domain, scratch):
         elif count:
             from rclpy_common import RosEnv
             env = RosEnv(domain)
-            extra = ["--filter", ROS_FILTER] if kind == "ros2_filter" else []
+            extra = ["--filter", ROS_FILTER] if kind.startswith("ros2_filter") else []
+            extra += ["--best-effort"] if kind.endswith("_best_effort") else []
             readers = subprocess.Popen(env.argv("hold", "--count", count, "--seconds", 600, *extra),
                                        stdout=subprocess.DEVNULL, stderr=open(readers_err, "w"))
         if count:
