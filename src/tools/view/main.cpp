@@ -112,7 +112,9 @@ int run(const Options& options) {
   rsg::tools::view::Server server(options.server, channels.channels(), web_files(options));
   spdlog::info("serving ws://{0}:{1} and http://{0}:{1}/", options.server.host, server.port());
 
-  rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery);
+  rsg::dds::WriterDirectory writers;  // what discovery shows, should no writer match
+  rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery,
+                                    writers.listener());
   rsg::tools::MonitorReaders readers(participant, options.topics());
   StopOnSignal stop_on_signal([&readers] { readers.request_stop(); });
 
@@ -125,7 +127,7 @@ int run(const Options& options) {
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
   bool summary_pending = false;
-  rsg::tools::MatchedWriters matched_writers(options.topic);
+  rsg::tools::MatchedWriters matched_writers(options.topic, writers, options.domain);
   while (!readers.stop_requested()) {
     readers.wait(kWakeUp);
     matched_writers.update(readers.state());

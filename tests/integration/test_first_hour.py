@@ -1,0 +1,53 @@
+"""What a new user sees when the most common set-up mistakes happen (issue 30): each message says
+what is wrong, with the numbers, and what to check.
+
+1. rsg_echo and rsg_record in the wrong partition: after a few seconds without a writer they say what
+   they look for (domain, partition, topic, type) and which writer of that topic they see instead
+   ("a writer of 'robot_state' ... exists in partition 'robot2'"); with nothing on the domain, they say so.
+"""
+
+import sys
+
+from harness import check, free_udp_port, main, read_json, wait_for, wait_for_stats
+
+
+def stderr_of(h, label):
+    path = h.dir / f"{label}.err"
+    return path.read_text(errors="replace") if path.exists() else ""
+
+
+def wait_for_line(h, label, text, timeout_s=20):
+    return wait_for(lambda: text in stderr_of(h, label), f"{label} to say '{text}'", timeout_s)
+
+
+def body(h):
+    # 1. A gateway in partition robot2, readers in robot1.
+    port = free_udp_port()
+    gateway, stats = h.gateway("robot2", "--listen", f"127.0.0.1:{port}", "--partition", "robot2")
+    wait_for_stats(stats, lambda s: True, "the gateway to start")
+    domain = str(h.domain)
+    echo = h.start("echo", [h.binary("rsg_echo"), "--domain", domain, "--partition", "robot1", "--json"])
+    record = h.start("record", [h.binary("rsg_record"), "--domain", domain, "--partition", "robot1",
+                                "--out", str(h.dir / "robot.mcap")])
+    for label, tool in (("echo", "rsg_echo"), ("record", "rsg_record")):
+        wait_for_line(h, label, f"{tool}: warning: a writer of 'robot_state' (type 'rsg::RobotState') exists in "
+                                "partition 'robot2': another partition (--partition robot2)")
+        text = stderr_of(h, label)
+        check(f"{tool}: warning: no writer matched: this reader looks for topic 'robot_state', type "
+              f"'rsg::RobotState', in partition 'robot1' on domain {domain}" in text, f"{label}: {text}")
+        check(text.count("no writer matched") == 1, f"{label} said it more than once: {text}")
+    for label, process in (("echo", echo), ("record", record)):
+        check(h.stop(label, process) == 0, f"{label} did not exit 0 on SIGTERM")
+    check(h.stop("robot2", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+
+    # 1. Nobody at all on the domain.
+    empty_domain = str((h.domain + 101) % 233)
+    status = h.run("lonely", [h.binary("rsg_echo"), "--domain", empty_domain, "--timeout", "4"])
+    check(status == 1, f"rsg_echo --timeout exited {status}")
+    check(f"rsg_echo: warning: no writer of any topic is visible on domain {empty_domain}: is the gateway "
+          "running, on this --domain" in stderr_of(h, "lonely"), stderr_of(h, "lonely"))
+
+
+
+if __name__ == "__main__":
+    sys.exit(main("first_hour", body))
