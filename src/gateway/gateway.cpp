@@ -214,7 +214,10 @@ Gateway::Gateway(const GatewaySetup& setup)
 
 void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump) {
   const auto start = Clock::now();
-  if (ingress_) ingress_->start(start);
+  if (ingress_) {
+    ingress_->start(start);
+    no_link_.emplace(ingress_->local_endpoint().to_string(), start);
+  }
   rate_.update(0, start);
   status_.publish(snapshot());
   auto next_status = start + kStatusPeriod;
@@ -274,6 +277,8 @@ void Gateway::on_status_period(Clock::time_point now) {
   if (ingress_) ingress_->end_status_period();
   status_.publish(stats);
   write_stats_file(stats);
+  if (no_link_)
+    if (const auto warning = no_link_->due(stats, now)) spdlog::warn("{}", *warning);
   if (now >= next_summary_) {
     next_summary_ = now + kSummaryPeriod;
     spdlog::info("{}", summary_line(stats));

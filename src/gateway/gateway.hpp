@@ -12,6 +12,7 @@
 #include "egress.hpp"
 #include "ingress.hpp"
 #include "link_monitor.hpp"
+#include "no_link_warning.hpp"
 #include "status_publisher.hpp"
 
 namespace rsg::gateway {
@@ -56,6 +57,7 @@ class Gateway {
   RateMeter rate_;
   double rate_hz_ = 0;
   Clock::time_point next_summary_{};
+  std::optional<NoLinkWarning> no_link_;  // with ingress
 };
 
 /// Puts the calling thread (the one that will call `Gateway::run`) in the configured real-time

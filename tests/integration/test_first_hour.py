@@ -4,6 +4,7 @@ what is wrong, with the numbers, and what to check.
 1. rsg_echo and rsg_record in the wrong partition: after a few seconds without a writer they say what
    they look for (domain, partition, topic, type) and which writer of that topic they see instead
    ("a writer of 'robot_state' ... exists in partition 'robot2'"); with nothing on the domain, they say so.
+2. A gateway that has received no datagram since start-up says so once, after 10 s, naming its address.
 """
 
 import sys
@@ -21,6 +22,10 @@ def wait_for_line(h, label, text, timeout_s=20):
 
 
 def body(h):
+    # 2. starts first: its 10 s run while the rest happens.
+    silent_port = free_udp_port()
+    silent, _ = h.gateway("silent", "--listen", f"127.0.0.1:{silent_port}")
+
     # 1. A gateway in partition robot2, readers in robot1.
     port = free_udp_port()
     gateway, stats = h.gateway("robot2", "--listen", f"127.0.0.1:{port}", "--partition", "robot2")
@@ -47,6 +52,10 @@ def body(h):
     check(f"rsg_echo: warning: no writer of any topic is visible on domain {empty_domain}: is the gateway "
           "running, on this --domain" in stderr_of(h, "lonely"), stderr_of(h, "lonely"))
 
+    # 2. The silent gateway, by now.
+    wait_for_line(h, "silent", f"no datagram on 127.0.0.1:{silent_port} for 10 s: is the robot sending here")
+    check(h.stop("silent", silent) == 0, "the gateway did not exit 0 on SIGTERM")
+    check(stderr_of(h, "silent").count("no datagram on") == 1, "the warning came more than once")
 
 
 if __name__ == "__main__":
