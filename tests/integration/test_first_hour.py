@@ -5,6 +5,8 @@ what is wrong, with the numbers, and what to check.
    they look for (domain, partition, topic, type) and which writer of that topic they see instead
    ("a writer of 'robot_state' ... exists in partition 'robot2'"); with nothing on the domain, they say so.
 2. A gateway that has received no datagram since start-up says so once, after 10 s, naming its address.
+3. A robot that does not answer the selection request (--robot names a port nobody listens on):
+   after three tries the gateway warns once, with the numbers, and slows down.
 """
 
 import sys
@@ -51,6 +53,24 @@ def body(h):
     check(status == 1, f"rsg_echo --timeout exited {status}")
     check(f"rsg_echo: warning: no writer of any topic is visible on domain {empty_domain}: is the gateway "
           "running, on this --domain" in stderr_of(h, "lonely"), stderr_of(h, "lonely"))
+
+    # 3. The robot streams from one port and is asked on another, where nobody listens.
+    port = free_udp_port()
+    nobody = free_udp_port()
+    gateway, stats = h.gateway("asking", "--listen", f"127.0.0.1:{port}", "--request-groups", "2",
+                               "--robot", f"127.0.0.1:{nobody}", "--expected-rate", "100")
+    wait_for_stats(stats, lambda s: True, "the gateway to start")
+    report_path = h.dir / "sim.report.json"
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "100", "--count", "600",
+                          "--report", str(report_path)])
+    wait_for_line(h, "asking", f"3 selection requests to 127.0.0.1:{nobody} went unanswered: the frames from "
+                               "127.0.0.1:")
+    text = stderr_of(h, "asking")
+    check("still carry group_select=0x3f, not 0x04" in text and "Asking every 10 s from now on" in text, text)
+    check(text.count(f"asked 127.0.0.1:{nobody} for selection") == 3, f"not three requests before the warning: {text}")
+    check(h.wait("sim", sim, 30) == 0, "rsg_sim failed")
+    check(read_json(report_path)["selection_requests"] == 0, "the sim got a request it should not have")
+    check(h.stop("asking", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
 
     # 2. The silent gateway, by now.
     wait_for_line(h, "silent", f"no datagram on 127.0.0.1:{silent_port} for 10 s: is the robot sending here")
