@@ -7,9 +7,10 @@ import json
 import os
 import socket
 import sys
+import time
 from pathlib import Path
 
-from harness import check, main, read_json, wait_for_stats, free_udp_port
+from harness import check, main, read_json, wait_for, wait_for_stats, free_udp_port
 
 
 def port_is_free(port):
@@ -46,6 +47,15 @@ def body(h):
     broken = h.dir / "broken.xml"
     broken.write_text("<dds><profiles><data_writer profile_name='x'>")
     expect_refusal(h, "broken_profiles", ["--profiles", str(broken)], [str(broken)])
+
+    # Files the configuration names are checked before anything starts: the file and errno.
+    missing_dir = h.dir / "no_such_dir"
+    expect_refusal(h, "stats_dir_missing", ["--stats-file", str(missing_dir / "stats.json")],
+                   [f"--stats-file: cannot write '{missing_dir / 'stats.json'}'", "No such file or directory (ENOENT)"])
+    expect_refusal(h, "stats_file_is_dir", ["--stats-file", str(h.dir)], ["--stats-file", "Is a directory (EISDIR)"])
+    expect_refusal(h, "pcap_dir_missing", ["--pcap-ring", "5", "--pcap-dir", str(missing_dir)],
+                   ["--pcap-dir", str(missing_dir), "No such file or directory (ENOENT)"])
+    stats_file_warning_names_errno_once(h)
 
     # Flags override the file: the file names a missing profile, the flag a good one.
     config.write_text("writer-profile: no_such_writer\n")
@@ -115,6 +125,25 @@ def body(h):
     # test run beside this one), not to the gateway, which has exited.
     leftovers = shared_memory() - before - mapped_shared_memory()
     check(not leftovers, f"left in /dev/shm after SIGTERM: {sorted(leftovers)}")
+
+
+def stats_file_warning_names_errno_once(h):
+    """The stats file's directory disappears while the gateway runs: one warning with errno, not one a second."""
+    directory = h.dir / "stats_dir"
+    directory.mkdir()
+    stats = directory / "stats.json"
+    gateway = h.start("vanishing", [h.binary("rsg_gateway"), "--domain", str(h.domain), "--listen",
+                                    f"127.0.0.1:{free_udp_port()}", "--stats-file", str(stats)])
+    wait_for_stats(stats, lambda s: True, "the gateway to write its stats file")
+    for file in directory.iterdir():
+        file.unlink()
+    directory.rmdir()
+    warning = f"cannot write {stats}.partial: No such file or directory (ENOENT)"
+    err = h.dir / "vanishing.err"
+    wait_for(lambda: warning in err.read_text(), "the stats file warning")
+    time.sleep(2.5)  # two more writes fail the same way
+    check(h.stop("vanishing", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+    check(err.read_text().count("cannot write") == 1, f"the warning was repeated: {err.read_text()}")
 
 
 def shared_memory():
