@@ -45,8 +45,10 @@ def body(h):
     expect_refusal(h, "bad_network", ["--allow-from", "10.0.0.0/33"], ["--allow-from", "10.0.0.0/33"])
     expect_refusal(h, "missing_profile", ["--writer-profile", "no_such_writer"], ["no_such_writer"])
     broken = h.dir / "broken.xml"
-    broken.write_text("<dds><profiles><data_writer profile_name='x'>")
-    expect_refusal(h, "broken_profiles", ["--profiles", str(broken)], [str(broken)])
+    broken.write_text("<dds>\n<profiles>\n<data_writer profile_name='x'></data_reader>\n</profiles>\n</dds>\n")
+    expect_refusal(h, "broken_profiles", ["--profiles", str(broken)],
+                   [f"{broken}:3: not well-formed XML (XML_ERROR_MISMATCHED_ELEMENT"])
+    profile_errors_come_first_on_stderr(h)
 
     # Files the configuration names are checked before anything starts: the file and errno.
     missing_dir = h.dir / "no_such_dir"
@@ -125,6 +127,22 @@ def body(h):
     # test run beside this one), not to the gateway, which has exited.
     leftovers = shared_memory() - before - mapped_shared_memory()
     check(not leftovers, f"left in /dev/shm after SIGTERM: {sorted(leftovers)}")
+
+
+def profile_errors_come_first_on_stderr(h):
+    """Well-formed XML Fast DDS rejects: its own reasons on stderr (not stdout, a tool's output), then
+    the one line naming the file."""
+    wrong = h.dir / "wrong.xml"
+    wrong.write_text("<dds><profiles><data_writer profile_name='x'><qos><no_such_policy/></qos>"
+                     "</data_writer></profiles></dds>\n")
+    status = h.run("wrong_profiles", [h.binary("rsg_echo"), "--domain", str(h.domain), "--json",
+                                      "--profiles", str(wrong)])
+    err = (h.dir / "wrong_profiles.err").read_text()
+    check(status == 2, f"wrong_profiles: exit status {status}, expected 2 ({err.strip()})")
+    check(h.output("wrong_profiles").read_text() == "", "Fast DDS's log went to stdout, the tool's output")
+    ours = err.find(f"rsg_echo: {wrong}: Fast DDS rejected this XML profile file")
+    theirs = err.find("no_such_policy")
+    check(ours >= 0 and 0 <= theirs < ours, f"Fast DDS's reason is not on stderr before rsg_echo's line: {err}")
 
 
 def stats_file_warning_names_errno_once(h):
