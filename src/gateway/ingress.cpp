@@ -197,6 +197,7 @@ void Ingress::write_rate_topics(const RobotState& sample, std::chrono::nanosecon
 
 void Ingress::reject(const wire::FrameError& error, const transport::Endpoint& sender) {
   ++counters_.invalid[invalid_index(error.category())];
+  sequence_.on_invalid();  // counted as invalid, not also as lost
   last_rejection_ = error;
   last_rejected_sender_ = sender;
 }
