@@ -1,7 +1,7 @@
 """What a new user sees when the most common set-up mistakes happen (issue 30): each message says
 what is wrong, with the numbers, and what to check.
 
-1. rsg_echo and rsg_record in the wrong partition: after a few seconds without a writer they say what
+1. rsg_echo, rsg_record and rsg_view in the wrong partition: after a few seconds without a writer they say what
    they look for (domain, partition, topic, type) and which writer of that topic they see instead
    ("a writer of 'robot_state' ... exists in partition 'robot2'"); with nothing on the domain, they say so.
 2. A gateway that has received no datagram since start-up says so once, after 10 s, naming its address.
@@ -9,9 +9,16 @@ what is wrong, with the numbers, and what to check.
    after three tries the gateway warns once, with the numbers, and slows down.
 """
 
+import socket
 import sys
 
 from harness import check, free_udp_port, main, read_json, wait_for, wait_for_stats
+
+
+def free_tcp_port():
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
 
 
 def stderr_of(h, label):
@@ -36,14 +43,16 @@ def body(h):
     echo = h.start("echo", [h.binary("rsg_echo"), "--domain", domain, "--partition", "robot1", "--json"])
     record = h.start("record", [h.binary("rsg_record"), "--domain", domain, "--partition", "robot1",
                                 "--out", str(h.dir / "robot.mcap")])
-    for label, tool in (("echo", "rsg_echo"), ("record", "rsg_record")):
+    view = h.start("view", [h.binary("rsg_view"), "--domain", domain, "--partition", "robot1",
+                            "--listen", f"127.0.0.1:{free_tcp_port()}"])
+    for label, tool in (("echo", "rsg_echo"), ("record", "rsg_record"), ("view", "rsg_view")):
         wait_for_line(h, label, f"{tool}: warning: a writer of 'robot_state' (type 'rsg::RobotState') exists in "
                                 "partition 'robot2': another partition (--partition robot2)")
         text = stderr_of(h, label)
         check(f"{tool}: warning: no writer matched: this reader looks for topic 'robot_state', type "
               f"'rsg::RobotState', in partition 'robot1' on domain {domain}" in text, f"{label}: {text}")
         check(text.count("no writer matched") == 1, f"{label} said it more than once: {text}")
-    for label, process in (("echo", echo), ("record", record)):
+    for label, process in (("echo", echo), ("record", record), ("view", view)):
         check(h.stop(label, process) == 0, f"{label} did not exit 0 on SIGTERM")
     check(h.stop("robot2", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
 
