@@ -84,6 +84,21 @@ std::string last_component(const std::string& topic) {
   return slash == std::string::npos ? topic : topic.substr(slash + 1);
 }
 
+// A ROS 2 name, as rsg_gateway --ros2 and rmw write them: rt/<ns>/<name>, type <pkg>::msg::dds_::<T>_.
+bool is_ros2(const std::string& topic, const std::string& type) {
+  return topic.starts_with("rt/") && type.find("::msg::dds_::") != std::string::npos;
+}
+
+// How to read a writer whose naming (ROS 2 or rsg's own) differs from the reader's.
+std::string naming_hint(const DiscoveredWriter& writer) {
+  if (!is_ros2(writer.topic, writer.type)) return "rsg's own names, as rsg_gateway writes without --ros2";
+  const std::string path = writer.topic.substr(3);  // without "rt/"
+  const auto slash = path.rfind('/');
+  std::string hint = "ROS 2 names, as rsg_gateway --ros2 writes: rsg_echo --ros2";
+  if (slash != std::string::npos) hint += " --ros2-namespace /" + path.substr(0, slash);
+  return hint + " reads it";
+}
+
 std::string partition_flags(const std::vector<std::string>& partitions) {
   if (partitions.empty()) return "no --partition";
   std::string flags;
@@ -129,7 +144,10 @@ std::vector<std::string> explain_no_writer(const WantedWriter& wanted,
     std::string line = "a writer of '" + writer.topic + "' (type '" + writer.type + "') exists in " +
                        describe_partitions(writer.partitions);
     const bool same_partition = partitions_match(writer.partitions, wanted.partitions);
-    if (!same_topic)
+    if (!same_topic && is_ros2(writer.topic, writer.type) != is_ros2(wanted.topic, wanted.type))
+      line += ": " + naming_hint(writer) +
+              (same_partition ? "" : " (" + partition_flags(writer.partitions) + ")");
+    else if (!same_topic)
       line += ": another topic name (--topic " + writer.topic +
               (same_partition ? "" : ", " + partition_flags(writer.partitions)) + ")";
     else if (!same_partition)

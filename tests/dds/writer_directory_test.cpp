@@ -59,7 +59,8 @@ TEST(WriterDirectory, AnotherTopicOrTypeOfTheSameDataIsNamed) {
   EXPECT_EQ(
       lines[1],
       "a writer of 'rt/robot1/robot_state' (type 'rsg_msgs::msg::dds_::RobotState_') exists in partition "
-      "'robot1': another topic name (--topic rt/robot1/robot_state)");
+      "'robot1': ROS 2 names, as rsg_gateway --ros2 writes: rsg_echo --ros2 --ros2-namespace /robot1 reads "
+      "it");
   EXPECT_EQ(
       lines[2],
       "a writer of 'robot_state' (type 'rsg_msgs::msg::dds_::RobotState_') exists in partition 'robot1': "
@@ -68,6 +69,23 @@ TEST(WriterDirectory, AnotherTopicOrTypeOfTheSameDataIsNamed) {
   EXPECT_EQ(lines[3],
             "a writer of 'arm' (type 'rsg::RobotState') exists in partition 'robot*': another topic name "
             "(--topic arm)");
+}
+
+TEST(WriterDirectory, AReaderWithRos2NamesIsToldAboutAGatewayWithout) {
+  const WantedWriter ros2{0, "rt/robot_state", "rsg_msgs::msg::dds_::RobotState_", {}};
+  const auto lines = explain_no_writer(ros2, {{"robot_state", "rsg::RobotState", {"robot1"}}});
+  ASSERT_EQ(lines.size(), 2u) << joined(lines);
+  EXPECT_EQ(
+      lines[1],
+      "a writer of 'robot_state' (type 'rsg::RobotState') exists in partition 'robot1': rsg's own names, "
+      "as rsg_gateway writes without --ros2 (--partition robot1)");
+  const auto rooted =
+      explain_no_writer(kWanted, {{"rt/robot_state", "rsg_msgs::msg::dds_::RobotState_", {}}});
+  ASSERT_EQ(rooted.size(), 2u) << joined(rooted);
+  EXPECT_EQ(
+      rooted[1],
+      "a writer of 'rt/robot_state' (type 'rsg_msgs::msg::dds_::RobotState_') exists in the default "
+      "partition: ROS 2 names, as rsg_gateway --ros2 writes: rsg_echo --ros2 reads it (no --partition)");
 }
 
 TEST(WriterDirectory, AWriterThatShouldMatchButDoesNotPointsAtQosOrSecurity) {
