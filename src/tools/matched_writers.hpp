@@ -49,9 +49,13 @@ class MatchedWriters {
       ever_matched_ |= writers_ > 0;
       spdlog::info("matched {} {} of '{}'", writers_, writers_ == 1 ? "writer" : "writers", topic_);
     }
-    if (directory_ == nullptr || explained_ || ever_matched_ ||
-        std::chrono::steady_clock::now() - start_ < kExplainAfter)
-      return;
+    if (std::chrono::steady_clock::now() - start_ >= kExplainAfter) explain_if_unmatched(reader);
+  }
+
+  /// The explanation now, if no writer has matched yet and it was not given (e.g. before a tool
+  /// gives up on its --timeout sooner than kExplainAfter).
+  void explain_if_unmatched(eprosima::fastdds::dds::DataReader& reader) {
+    if (directory_ == nullptr || explained_ || ever_matched_) return;
     explained_ = true;
     for (const std::string& line : dds::explain_no_writer(wanted(reader), directory_->writers()))
       spdlog::warn("{}", line);

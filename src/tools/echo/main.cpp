@@ -264,6 +264,7 @@ int run(const Options& options) {
     sink.flush(now, done);
     if (done) return kExitOk;
     if (options.timeout_seconds > 0 && now - last_sample >= timeout) {
+      matched_writers.explain_if_unmatched(*reader);
       spdlog::error("no sample on '{}' for {} s", read_topic, options.timeout_seconds);
       return kExitFailure;
     }
