@@ -1,6 +1,7 @@
 // One log line whenever the number of writers a tool's reader is matched with changes, e.g.
-// "rsg_echo: matched 1 writer of 'robot_state'"; and, when no writer has matched a few seconds
-// after start-up, what the reader looks for and what discovery shows instead:
+// "rsg_echo: matched 1 writer of 'robot_state'"; when a matched reader gets no sample for a few
+// seconds, where to look; and, when no writer has matched a few seconds after start-up, what the
+// reader looks for and what discovery shows instead:
 //
 //   rsg_echo: warning: no writer matched: this reader looks for topic 'robot_state', type
 //             'rsg::RobotState', in partition 'robot1' on domain 0
@@ -33,6 +34,8 @@ class MatchedWriters {
  public:
   /// How long a reader may go without any writer before the tool explains what it sees.
   static constexpr std::chrono::seconds kExplainAfter{3};
+  /// How long a matched reader may go without a sample before the tool says where to look.
+  static constexpr std::chrono::seconds kSilenceAfter{5};
 
   explicit MatchedWriters(std::string topic) : topic_(std::move(topic)) {}
   /// Also explains, once, when no writer has matched `kExplainAfter` from now. `directory` is the
@@ -44,13 +47,31 @@ class MatchedWriters {
   void update(eprosima::fastdds::dds::DataReader& reader) {
     eprosima::fastdds::dds::SubscriptionMatchedStatus matched;
     reader.get_subscription_matched_status(matched);
+    const auto now = std::chrono::steady_clock::now();
     if (matched.current_count != writers_) {
+      if (writers_ == 0 && !ever_matched_) matched_at_ = now;
       writers_ = matched.current_count;
       ever_matched_ |= writers_ > 0;
       spdlog::info("matched {} {} of '{}'", writers_, writers_ == 1 ? "writer" : "writers", topic_);
     }
-    if (std::chrono::steady_clock::now() - start_ >= kExplainAfter) explain_if_unmatched(reader);
+    if (now - start_ >= kExplainAfter) explain_if_unmatched(reader);
+    if (directory_ != nullptr && ever_matched_ && writers_ > 0 && !sampled_ && !silence_said_ &&
+        now - matched_at_ >= kSilenceAfter) {
+      silence_said_ = true;
+      const bool view = dynamic_cast<const eprosima::fastdds::dds::ContentFilteredTopic*>(
+                            reader.get_topicdescription()) != nullptr;
+      spdlog::warn(
+          "matched {} {} of '{}' {} s ago, but no sample has arrived: does the gateway get valid frames? (it "
+          "warns 'no datagram on ...' when not; its --stats-file shows link_up and frames_received){}",
+          writers_, writers_ == 1 ? "writer" : "writers", topic_, kSilenceAfter.count(),
+          view ? "; or no frame carries every group of this view (rsg_echo without --view shows the robot's "
+                 "selection, group_select)"
+               : "");
+    }
   }
+
+  /// A sample arrived: the reader is not silent.
+  void on_sample() { sampled_ = true; }
 
   /// The explanation now, if no writer has matched yet and it was not given (e.g. before a tool
   /// gives up on its --timeout sooner than kExplainAfter).
@@ -78,8 +99,11 @@ class MatchedWriters {
   const dds::WriterDirectory* directory_ = nullptr;
   int domain_ = 0;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point matched_at_;
   bool ever_matched_ = false;
   bool explained_ = false;
+  bool sampled_ = false;
+  bool silence_said_ = false;
 };
 
 }  // namespace rsg::tools

@@ -4,7 +4,9 @@ what is wrong, with the numbers, and what to check.
 1. rsg_echo, rsg_record and rsg_view in the wrong partition: after a few seconds without a writer they say what
    they look for (domain, partition, topic, type) and which writer of that topic they see instead
    ("a writer of 'robot_state' ... exists in partition 'robot2'"); with nothing on the domain, they say so.
-2. A gateway that has received no datagram since start-up says so once, after 10 s, naming its address.
+2. A gateway that has received no datagram since start-up says so once, after 10 s, naming its address;
+   a reader matched with it says after 5 s that no sample arrives and where to look, and a view
+   reader whose groups no frame carries says that too.
 3. A robot that does not answer the selection request (--robot names a port nobody listens on):
    after three tries the gateway warns once, with the numbers, and slows down.
 """
@@ -33,7 +35,10 @@ def wait_for_line(h, label, text, timeout_s=20):
 def body(h):
     # 2. starts first: its 10 s run while the rest happens.
     silent_port = free_udp_port()
-    silent, _ = h.gateway("silent", "--listen", f"127.0.0.1:{silent_port}")
+    silent, silent_stats = h.gateway("silent", "--listen", f"127.0.0.1:{silent_port}", "--partition", "silent")
+    wait_for_stats(silent_stats, lambda s: True, "the silent gateway to start")
+    matched = h.start("matched", [h.binary("rsg_echo"), "--domain", str(h.domain), "--partition", "silent",
+                                  "--json"])
 
     # 1. A gateway in partition robot2, readers in robot1.
     port = free_udp_port()
@@ -63,6 +68,22 @@ def body(h):
     check(f"rsg_echo: warning: no writer of any topic is visible on domain {empty_domain}: is the gateway "
           "running, on this --domain" in stderr_of(h, "lonely"), stderr_of(h, "lonely"))
 
+    # 2. A view whose groups the robot does not send.
+    port = free_udp_port()
+    viewed, stats = h.gateway("viewed", "--listen", f"127.0.0.1:{port}", "--partition", "viewed")
+    wait_for_stats(stats, lambda s: True, "the gateway to start")
+    view_echo = h.start("view_echo", [h.binary("rsg_echo"), "--domain", domain, "--partition", "viewed",
+                                      "--view", "view_joints", "--json"])
+    wait_for_line(h, "view_echo", "rsg_echo: matched 1 writer of ")
+    sim = h.start("poses_sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "100",
+                                "--count", "900", "--groups", "0"])
+    wait_for_line(h, "view_echo", "but no sample has arrived")
+    check("or no frame carries every group of this view" in stderr_of(h, "view_echo"), stderr_of(h, "view_echo"))
+    check(h.output("view_echo").read_text() == "", "the view got samples without group 2")
+    sim.kill()
+    for label, process in (("view_echo", view_echo), ("viewed", viewed)):
+        check(h.stop(label, process) == 0, f"{label} did not exit 0 on SIGTERM")
+
     # 3. The robot streams from one port and is asked on another, where nobody listens.
     port = free_udp_port()
     nobody = free_udp_port()
@@ -85,6 +106,10 @@ def body(h):
     wait_for_line(h, "silent", f"no datagram on 127.0.0.1:{silent_port} for 10 s: is the robot sending here")
     check(h.stop("silent", silent) == 0, "the gateway did not exit 0 on SIGTERM")
     check(stderr_of(h, "silent").count("no datagram on") == 1, "the warning came more than once")
+    text = stderr_of(h, "matched")
+    check("rsg_echo: warning: matched 1 writer of 'robot_state' 5 s ago, but no sample has arrived: does the "
+          "gateway get valid frames?" in text and "group of this view" not in text, text)
+    check(h.stop("matched", matched) == 0, "rsg_echo did not exit 0 on SIGTERM")
 
 
 if __name__ == "__main__":

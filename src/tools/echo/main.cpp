@@ -256,6 +256,7 @@ int run(const Options& options) {
         // for a newer sample before or while it was copied; such a copy is no sample at all.
         if (!reader->is_sample_valid(&samples[i], &infos[i])) continue;
         sink.add(values, now);
+        matched_writers.on_sample();
         last_sample = now;
         done = options.count != 0 && ++received == options.count;
       }

@@ -284,6 +284,7 @@ int run(const Options& options, rsg::tools::record::Profile profile) {
   const auto write_what_was_received = [&] {
     while (readers.state().take_next_sample(&state, &info) == rsg::dds::kOk) {
       if (!info.valid_data) continue;
+      matched_writers.on_sample();
       loss.add(info);
       recording.add_state(state, info);
     }

@@ -133,6 +133,7 @@ int run(const Options& options) {
     matched_writers.update(readers.state());
     while (readers.state().take_next_sample(&state, &info) == rsg::dds::kOk) {
       if (!info.valid_data) continue;
+      matched_writers.on_sample();
       const std::uint64_t time = now_ns();
       const auto cdr = payload_of(serializer.serialize(state));
       for (const auto channel : channels.robot_state_cdr()) server.publish(channel, time, cdr);
