@@ -40,11 +40,14 @@ fdds::DomainParticipantQos with_discovery(fdds::DomainParticipantQos qos, int do
 
 }  // namespace
 
-Participant::Participant(int domain, const std::string& profile, const DiscoveryOptions& discovery)
-    : Participant(domain, with_discovery(profile_qos(profile), domain, discovery)) {}
+Participant::Participant(int domain, const std::string& profile, const DiscoveryOptions& discovery,
+                         fdds::DomainParticipantListener* listener)
+    : Participant(domain, with_discovery(profile_qos(profile), domain, discovery), listener) {}
 
-Participant::Participant(int domain, const fdds::DomainParticipantQos& qos) {
-  participant_ = fdds::DomainParticipantFactory::get_instance()->create_participant(domain, qos);
+Participant::Participant(int domain, const fdds::DomainParticipantQos& qos,
+                         fdds::DomainParticipantListener* listener) {
+  participant_ = fdds::DomainParticipantFactory::get_instance()->create_participant(domain, qos, listener,
+                                                                                    fdds::StatusMask::none());
   if (!participant_)
     throw EnvironmentError("cannot create DDS participant on domain " + std::to_string(domain));
 }

@@ -1,10 +1,13 @@
 #include "rsg/dds/profiles.hpp"
 
+#include <tinyxml2.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/log/Log.hpp>
+#include <fastdds/dds/log/StdoutErrConsumer.hpp>
 #include <stdexcept>
 #include <vector>
 
@@ -13,6 +16,38 @@
 
 namespace rsg::dds {
 namespace {
+
+// Fast DDS logs through its own consumers, by default to stdout, where a tool's output goes (rsg_echo
+// --json, rsg_frame), and from a thread of its own, after whatever the caller printed meanwhile.
+// Its warnings and errors go to stderr here, like everything else a program says.
+void fastdds_log_to_stderr() {
+  static const bool done = [] {
+    namespace fdds = eprosima::fastdds::dds;
+    auto consumer = std::make_unique<fdds::StdoutErrConsumer>();
+    consumer->stderr_threshold(fdds::Log::Kind::Warning);
+    fdds::Log::ClearConsumers();
+    fdds::Log::RegisterConsumer(std::move(consumer));
+    return true;
+  }();
+  (void)done;
+}
+
+// Fast DDS says only "Error opening" or "Error parsing" for a file that is not well-formed XML:
+// tinyxml2 (which Fast DDS parses with) names the line and what is wrong.
+void check_well_formed(const std::filesystem::path& file) {
+  tinyxml2::XMLDocument document;
+  if (document.LoadFile(file.c_str()) == tinyxml2::XML_SUCCESS) return;
+  std::string what = document.ErrorName();
+  if (const char* detail = document.ErrorStr(); detail != nullptr) {
+    // ErrorStr() reads "Error=XML_ERROR_... ErrorID=7 (0x7) Line number=3: what": keep the what.
+    const std::string text = detail;
+    const auto colon = text.find(": ");
+    if (colon != std::string::npos) what += ": " + text.substr(colon + 2);
+  }
+  const int line = document.ErrorLineNum();
+  throw InputError(file.string() + (line > 0 ? ":" + std::to_string(line) : "") + ": not well-formed XML (" +
+                   what + ")");
+}
 
 std::filesystem::path running_binary_dir() {
   std::error_code error;
@@ -48,10 +83,15 @@ void load_profiles(const std::filesystem::path& file_or_dir) {
     files.push_back(file_or_dir);
   }
   if (files.empty()) throw InputError(file_or_dir.string() + ": no XML profiles found");
-  for (const auto& file : files)
-    if (load_xml_profiles_file(file.string()) != kOk)
+  fastdds_log_to_stderr();
+  for (const auto& file : files) {
+    check_well_formed(file);
+    if (load_xml_profiles_file(file.string()) != kOk) {
+      eprosima::fastdds::dds::Log::Flush();  // its reasons first, then this line
       throw InputError(file.string() +
-                       ": Fast DDS rejected this XML profile file (its log above says where)");
+                       ": Fast DDS rejected this XML profile file (the XMLPARSER lines above say why)");
+    }
+  }
 }
 
 void load_profiles(const std::vector<std::string>& files_or_dirs, const std::string& participant_profile) {

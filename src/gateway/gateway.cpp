@@ -4,9 +4,11 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 #include <thread>
 
@@ -35,6 +37,39 @@ transport::Endpoint resolve(const std::string& flag, const std::string& host_por
   } catch (const InputError& error) {
     throw InputError("--" + flag + ": " + error.what());
   }
+}
+
+// errno as "No such file or directory (ENOENT)".
+std::string errno_text(int error) {
+  const char* name = ::strerrorname_np(error);
+  return std::string(std::strerror(error)) + " (" + (name != nullptr ? name : std::to_string(error)) + ")";
+}
+
+// A directory the gateway will write into must exist and be writable: said at start-up, naming the
+// flag, the file and errno, instead of a warning at every write.
+void check_writable_dir(const std::string& flag, const std::filesystem::path& dir, const std::string& file) {
+  const std::filesystem::path where = dir.empty() ? std::filesystem::path(".") : dir;
+  std::error_code error;
+  if (!std::filesystem::exists(where, error))
+    throw InputError("--" + flag + ": cannot write '" + file + "': directory '" + where.string() +
+                     "': " + errno_text(ENOENT) + " (create it first, e.g. RuntimeDirectory= under systemd)");
+  if (!std::filesystem::is_directory(where, error))
+    throw InputError("--" + flag + ": cannot write '" + file + "': '" + where.string() +
+                     "': " + errno_text(ENOTDIR));
+  if (::access(where.c_str(), W_OK | X_OK) != 0)
+    throw InputError("--" + flag + ": cannot write '" + file + "': directory '" + where.string() +
+                     "': " + errno_text(errno));
+}
+
+void check_output_files(const GatewayConfig& config) {
+  if (!config.stats_file.empty()) {
+    const std::filesystem::path file = config.stats_file;
+    std::error_code error;
+    if (std::filesystem::is_directory(file, error))
+      throw InputError("--stats-file: '" + config.stats_file + "' is a directory: " + errno_text(EISDIR));
+    check_writable_dir("stats-file", file.parent_path(), config.stats_file);
+  }
+  if (config.pcap_ring > 0) check_writable_dir("pcap-dir", config.pcap_dir, config.pcap_dir + "/*.pcap");
 }
 
 std::filesystem::path profiles_of(const GatewayConfig& config) {
@@ -143,6 +178,8 @@ std::optional<Ros2StandardTopics::Options> standard_topics_of(const GatewayConfi
 GatewaySetup prepare(const GatewayConfig& config) {
   if (auto problem = check_config(config)) throw InputError(*problem);
 
+  check_output_files(config);
+
   GatewaySetup setup{config, std::nullopt, std::nullopt};
   if (config.has_ingress()) {
     Ingress::Options ingress;
@@ -167,9 +204,6 @@ GatewaySetup prepare(const GatewayConfig& config) {
     if (config.requests_selection()) ingress.requested_selection = requested_selection(config);
     if (!config.robot.empty()) ingress.robot = resolve("robot", config.robot);
     if (config.pcap_ring > 0) {
-      std::error_code error;
-      if (!std::filesystem::is_directory(config.pcap_dir, error))
-        throw InputError("--pcap-dir: '" + config.pcap_dir + "' is not a directory");
       ingress.flight_recorder = FlightRecorder::Options{std::chrono::duration<double>(config.pcap_ring),
                                                         config.expected_rate, config.pcap_dir};
     }
@@ -214,7 +248,10 @@ Gateway::Gateway(const GatewaySetup& setup)
 
 void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump) {
   const auto start = Clock::now();
-  if (ingress_) ingress_->start(start);
+  if (ingress_) {
+    ingress_->start(start);
+    no_link_.emplace(ingress_->local_endpoint().to_string(), start);
+  }
   rate_.update(0, start);
   status_.publish(snapshot());
   auto next_status = start + kStatusPeriod;
@@ -274,6 +311,8 @@ void Gateway::on_status_period(Clock::time_point now) {
   if (ingress_) ingress_->end_status_period();
   status_.publish(stats);
   write_stats_file(stats);
+  if (no_link_)
+    if (const auto warning = no_link_->due(stats, now)) spdlog::warn("{}", *warning);
   if (now >= next_summary_) {
     next_summary_ = now + kSummaryPeriod;
     spdlog::info("{}", summary_line(stats));
@@ -306,23 +345,28 @@ void enter_realtime_mode(const GatewayConfig& config) {
   spdlog::info("real-time mode: ingress thread {}", done);
 }
 
-void Gateway::write_stats_file(const GatewayStats& stats) const {
+void Gateway::write_stats_file(const GatewayStats& stats) {
   if (config_.stats_file.empty()) return;
   // Written aside and renamed, so that a reader never sees half a file.
-  const std::filesystem::path target = config_.stats_file;
-  std::filesystem::path partial = target;
-  partial += ".partial";
-  {
-    std::ofstream out(partial, std::ios::trunc);
-    out << to_json(stats) << '\n';
-    if (!out) {
-      spdlog::warn("cannot write {}", partial.string());
-      return;
-    }
+  const std::string& target = config_.stats_file;
+  const std::string partial = target + ".partial";
+  const std::string text = to_json(stats) + '\n';
+  const auto failed = [&](const std::string& file) {
+    const int error = errno;
+    // Once per cause, not every second; and once again when it works again.
+    if (std::exchange(stats_file_errno_, error) != error)
+      spdlog::warn("cannot write {}: {}", file, errno_text(error));
+  };
+  std::FILE* out = std::fopen(partial.c_str(), "w");
+  if (out == nullptr) return failed(partial);
+  const bool written = std::fwrite(text.data(), 1, text.size(), out) == text.size();
+  const int write_error = errno;
+  if (std::fclose(out) != 0 || !written) {
+    if (!written) errno = write_error;
+    return failed(partial);
   }
-  std::error_code error;
-  std::filesystem::rename(partial, target, error);
-  if (error) spdlog::warn("cannot write {}: {}", target.string(), error.message());
+  if (std::rename(partial.c_str(), target.c_str()) != 0) return failed(target);
+  if (std::exchange(stats_file_errno_, 0) != 0) spdlog::info("writing {} again", target);
 }
 
 }  // namespace rsg::gateway

@@ -12,6 +12,7 @@
 #include "egress.hpp"
 #include "ingress.hpp"
 #include "link_monitor.hpp"
+#include "no_link_warning.hpp"
 #include "status_publisher.hpp"
 
 namespace rsg::gateway {
@@ -46,7 +47,7 @@ class Gateway {
   void dump_flight_recorder(std::string_view reason);
   void on_status_period(Clock::time_point now);
   GatewayStats snapshot() const;
-  void write_stats_file(const GatewayStats& stats) const;
+  void write_stats_file(const GatewayStats& stats);
 
   GatewayConfig config_;
   dds::Participant participant_;  // first: outlives every entity below
@@ -56,6 +57,8 @@ class Gateway {
   RateMeter rate_;
   double rate_hz_ = 0;
   Clock::time_point next_summary_{};
+  std::optional<NoLinkWarning> no_link_;  // with ingress
+  int stats_file_errno_ = 0;              // of the last failed write of the stats file; 0: it worked
 };
 
 /// Puts the calling thread (the one that will call `Gateway::run`) in the configured real-time

@@ -197,6 +197,7 @@ void Ingress::write_rate_topics(const RobotState& sample, std::chrono::nanosecon
 
 void Ingress::reject(const wire::FrameError& error, const transport::Endpoint& sender) {
   ++counters_.invalid[invalid_index(error.category())];
+  sequence_.on_invalid();  // counted as invalid, not also as lost
   last_rejection_ = error;
   last_rejected_sender_ = sender;
 }
@@ -210,8 +211,7 @@ void Ingress::request_selection(const transport::Endpoint& robot, Clock::time_po
   // From the listening socket, so that the robot's answer (its stream) comes back to it. Rare (at
   // most once a second), so it may log.
   if (encoded && socket_.send_to(std::span(request).first(encoded.size), robot))
-    spdlog::info("asked {} for selection group_select=0x{:02x}", robot.to_string(),
-                 requester_->wanted().group_select);
+    requester_->log_sent(robot.to_string(), source_.size() ? source_.to_string() : std::string());
   else
     spdlog::warn("could not send the selection request to {}", robot.to_string());
 }

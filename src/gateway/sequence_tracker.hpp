@@ -22,8 +22,14 @@
 //     it did, the frame is a duplicate; if not, it arrives late: reordered, and no longer lost.
 //   * Restart: counted, and the frame starts a fresh sequence (nothing lost across a restart).
 //
-// "Lost" therefore means "never arrived valid": frames dropped by the network and frames the
-// decoder rejected look the same here.
+// An invalid frame (rejected by the decoder, so its packet number cannot be trusted) is counted
+// under its category, not as lost: `on_invalid()` notes it, and the next gaps ahead absorb one
+// skipped position per invalid frame, as long as they come within 16 valid frames of it (an
+// invalid datagram that fills no gap by then was not one of the robot's frames). A valid frame
+// that arrives late into such a gap is reordered, and the invalid one is taken to have held another
+// position of it (the simulator holds a frame back behind a corrupted one, and the gap shows only
+// at the next valid frame). "Lost" therefore means "never arrived at all" (dropped by the network or the sender), as
+// far as the packet numbers can tell.
 #pragma once
 
 #include <cstdint>
@@ -48,6 +54,12 @@ class SequenceTracker {
   /// Accounts one valid frame; `time_ms` is its `time` field when the frame carries one.
   void observe(std::uint8_t packet_number, std::optional<std::uint64_t> time_ms) noexcept;
 
+  /// Accounts one datagram the decoder rejected: it arrived, so the gap it leaves is not a loss.
+  void on_invalid() noexcept {
+    ++invalid_credits_;
+    frames_since_invalid_ = 0;
+  }
+
   const Counts& counts() const { return counts_; }
 
  private:
@@ -63,6 +75,10 @@ class SequenceTracker {
   std::optional<std::uint64_t> newest_time_ms_;
   // Bit a set: the frame `a` places behind the newest one has arrived (bit 0: the newest itself).
   std::uint64_t arrived_ = 0;
+  // Bit a set: the missing frame `a` places behind the newest is covered by an invalid frame.
+  std::uint64_t covered_ = 0;
+  std::uint64_t invalid_credits_ = 0;  // invalid frames not yet matched with a gap
+  unsigned frames_since_invalid_ = 0;
 };
 
 }  // namespace rsg::gateway

@@ -218,6 +218,26 @@ class Request(unittest.TestCase):
         self.assertEqual(status, 1)
         self.assertTrue(err.startswith("error: length_mismatch: "), err)
 
+    def test_decode_says_a_request_is_one_and_what_it_asks_for(self):
+        _, request, _ = run("request", "--groups", "2", "--packet-number", "5")
+        status, out, err = run("decode", stdin=request)
+        self.assertEqual((status, out), (1, b""))
+        lines = err.splitlines()
+        self.assertEqual(len(lines), 2, err)
+        self.assertTrue(lines[0].startswith("error: length_mismatch: "), err)
+        note = "note: these bytes are a selection request (gateway -> robot), not a state frame (robot -> gateway): "
+        self.assertTrue(lines[1].startswith(note), err)
+        self.assertEqual(json.loads(lines[1][len(note):]),
+                         {"packet_number": 5, "group_select": 4, "data_select": [0, 0, 255, 0, 0, 0],
+                          "fields": ["delbow_c", "ddelbow_c", "tau_J", "tau_J_d", "dtau_J", "q", "q_d", "dq"]})
+        # One hex line per record: the error keeps its category and carries the request.
+        _, hex_request, _ = run("request", "--fields", "q,time", "--hex")
+        status, out, _ = run("decode", "--hex-lines", stdin=hex_request)
+        self.assertEqual(status, 0)
+        line = json.loads(out)
+        self.assertEqual(line["error"], "length_mismatch")
+        self.assertEqual(line["selection_request"]["fields"], ["q", "time"])
+
     def test_bad_selections_are_usage_errors(self):
         for args in (["--groups", "6"], ["--fields", "q,nope"], ["--groups", "1", "--fields", "q"], [],
                      ["--groups", "1", "--packet-number", "16"]):

@@ -166,5 +166,106 @@ TEST(SequenceTracker, SimulatorFaultPatternIsCountedExactly) {
   EXPECT_EQ(counts.restarts, 0U);
 }
 
+// Issue 30: 8 corrupted frames read "lost 8" although the simulator dropped none.
+TEST(SequenceTracker, InvalidFramesAreNotAlsoCountedAsLost) {
+  SequenceTracker tracker;
+  for (std::uint64_t i = 0; i < 100; ++i) {
+    if (i % 12 == 5) {  // rejected by the decoder: reported to the tracker, not observed
+      tracker.on_invalid();
+      continue;
+    }
+    tracker.observe(static_cast<std::uint8_t>(i % 16), 5000 + i);
+  }
+  EXPECT_EQ(tracker.counts(), Counts{});
+}
+
+TEST(SequenceTracker, AGapLongerThanTheInvalidFramesIsStillLost) {
+  SequenceTracker tracker;
+  tracker.observe(0, 5000);
+  tracker.on_invalid();  // frame 1 arrived corrupted; frames 2 and 3 never arrived
+  tracker.observe(4, 5004);
+  EXPECT_EQ(tracker.counts(), (Counts{.lost = 2}));
+  tracker.observe(2, 5002);  // one of the lost ones arrives late after all
+  EXPECT_EQ(tracker.counts(), (Counts{.lost = 1, .reordered = 1}));
+}
+
+// The simulator holds frame 4 back and sends it after the next one, which it corrupts: the gap
+// the invalid frame leaves shows only when frame 6 arrives.
+TEST(SequenceTracker, AnInvalidFrameFillsTheGapItLeavesEvenWhenThatShowsLater) {
+  SequenceTracker tracker;
+  tracker.observe(3, 5003);
+  tracker.on_invalid();      // 5, corrupted
+  tracker.observe(4, 5004);  // 4, held back: in order after 3
+  tracker.observe(6, 5006);  // the gap at 5
+  EXPECT_EQ(tracker.counts(), Counts{});
+}
+
+// The simulator releases a held-back frame only behind a valid one: 4 held, 5 corrupted, then 6, 4.
+TEST(SequenceTracker, AFrameHeldBackBehindAnInvalidOneIsReorderedNotDuplicated) {
+  SequenceTracker tracker;
+  tracker.observe(3, 5003);
+  tracker.on_invalid();      // 5
+  tracker.observe(6, 5006);  // 4 and 5 skipped; the invalid one covers one of them
+  tracker.observe(4, 5004);  // late
+  tracker.observe(7, 5007);
+  EXPECT_EQ(tracker.counts(), (Counts{.reordered = 1}));
+  // And without time, where only the packet number places a frame.
+  SequenceTracker untimed;
+  untimed.observe(3, std::nullopt);
+  untimed.on_invalid();
+  untimed.observe(6, std::nullopt);
+  untimed.observe(4, std::nullopt);
+  untimed.observe(7, std::nullopt);
+  EXPECT_EQ(untimed.counts(), (Counts{.reordered = 1}));
+}
+
+// The simulator's fault model with corruption: a corrupted frame is sent in place of the valid one.
+TEST(SequenceTracker, SimulatorFaultPatternWithCorruptionCountsOnlyDropsAsLost) {
+  SequenceTracker tracker;
+  std::uint64_t dropped = 0, duplicated = 0, reordered = 0;
+  std::optional<std::uint64_t> held_back;
+  const auto send = [&](std::uint64_t i) { tracker.observe(static_cast<std::uint8_t>(i % 16), 5000 + i); };
+  for (std::uint64_t i = 0; i < 5000; ++i) {
+    if (i % 7 == 6) {
+      ++dropped;
+      continue;
+    }
+    if (i % 17 == 16) {
+      tracker.on_invalid();
+      continue;
+    }
+    if (i % 13 == 12 && !held_back) {
+      held_back = i;
+      ++reordered;
+      continue;
+    }
+    send(i);
+    if (i % 11 == 10) {
+      send(i);
+      ++duplicated;
+    }
+    if (held_back) send(*std::exchange(held_back, std::nullopt));
+  }
+  EXPECT_EQ(tracker.counts(), (Counts{.lost = dropped, .duplicated = duplicated, .reordered = reordered}));
+}
+
+TEST(SequenceTracker, AnInvalidDatagramThatFillsNoGapSoonIsForgotten) {
+  SequenceTracker tracker;
+  tracker.observe(0, 5000);
+  tracker.on_invalid();  // not one of the robot's frames: no gap follows
+  for (std::uint64_t i = 1; i <= 17; ++i) tracker.observe(static_cast<std::uint8_t>(i % 16), 5000 + i);
+  tracker.observe(19 % 16, 5019);  // a real loss, 17 frames later, is still counted
+  EXPECT_EQ(tracker.counts(), (Counts{.lost = 1}));
+}
+
+TEST(SequenceTracker, InvalidFramesBeforeTheFirstValidOneCountNothing) {
+  SequenceTracker tracker;
+  tracker.on_invalid();
+  tracker.on_invalid();
+  tracker.observe(9, 5000);
+  tracker.observe(11, 5002);
+  EXPECT_EQ(tracker.counts(), (Counts{.lost = 1}));
+}
+
 }  // namespace
 }  // namespace rsg::gateway

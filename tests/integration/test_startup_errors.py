@@ -7,9 +7,10 @@ import json
 import os
 import socket
 import sys
+import time
 from pathlib import Path
 
-from harness import check, main, read_json, wait_for_stats, free_udp_port
+from harness import check, main, read_json, wait_for, wait_for_stats, free_udp_port
 
 
 def port_is_free(port):
@@ -44,8 +45,19 @@ def body(h):
     expect_refusal(h, "bad_network", ["--allow-from", "10.0.0.0/33"], ["--allow-from", "10.0.0.0/33"])
     expect_refusal(h, "missing_profile", ["--writer-profile", "no_such_writer"], ["no_such_writer"])
     broken = h.dir / "broken.xml"
-    broken.write_text("<dds><profiles><data_writer profile_name='x'>")
-    expect_refusal(h, "broken_profiles", ["--profiles", str(broken)], [str(broken)])
+    broken.write_text("<dds>\n<profiles>\n<data_writer profile_name='x'></data_reader>\n</profiles>\n</dds>\n")
+    expect_refusal(h, "broken_profiles", ["--profiles", str(broken)],
+                   [f"{broken}:3: not well-formed XML (XML_ERROR_MISMATCHED_ELEMENT"])
+    profile_errors_come_first_on_stderr(h)
+
+    # Files the configuration names are checked before anything starts: the file and errno.
+    missing_dir = h.dir / "no_such_dir"
+    expect_refusal(h, "stats_dir_missing", ["--stats-file", str(missing_dir / "stats.json")],
+                   [f"--stats-file: cannot write '{missing_dir / 'stats.json'}'", "No such file or directory (ENOENT)"])
+    expect_refusal(h, "stats_file_is_dir", ["--stats-file", str(h.dir)], ["--stats-file", "Is a directory (EISDIR)"])
+    expect_refusal(h, "pcap_dir_missing", ["--pcap-ring", "5", "--pcap-dir", str(missing_dir)],
+                   ["--pcap-dir", str(missing_dir), "No such file or directory (ENOENT)"])
+    stats_file_warning_names_errno_once(h)
 
     # Flags override the file: the file names a missing profile, the flag a good one.
     config.write_text("writer-profile: no_such_writer\n")
@@ -115,6 +127,41 @@ def body(h):
     # test run beside this one), not to the gateway, which has exited.
     leftovers = shared_memory() - before - mapped_shared_memory()
     check(not leftovers, f"left in /dev/shm after SIGTERM: {sorted(leftovers)}")
+
+
+def profile_errors_come_first_on_stderr(h):
+    """Well-formed XML Fast DDS rejects: its own reasons on stderr (not stdout, a tool's output), then
+    the one line naming the file."""
+    wrong = h.dir / "wrong.xml"
+    wrong.write_text("<dds><profiles><data_writer profile_name='x'><qos><no_such_policy/></qos>"
+                     "</data_writer></profiles></dds>\n")
+    status = h.run("wrong_profiles", [h.binary("rsg_echo"), "--domain", str(h.domain), "--json",
+                                      "--profiles", str(wrong)])
+    err = (h.dir / "wrong_profiles.err").read_text()
+    check(status == 2, f"wrong_profiles: exit status {status}, expected 2 ({err.strip()})")
+    check(h.output("wrong_profiles").read_text() == "", "Fast DDS's log went to stdout, the tool's output")
+    ours = err.find(f"rsg_echo: {wrong}: Fast DDS rejected this XML profile file")
+    theirs = err.find("no_such_policy")
+    check(ours >= 0 and 0 <= theirs < ours, f"Fast DDS's reason is not on stderr before rsg_echo's line: {err}")
+
+
+def stats_file_warning_names_errno_once(h):
+    """The stats file's directory disappears while the gateway runs: one warning with errno, not one a second."""
+    directory = h.dir / "stats_dir"
+    directory.mkdir()
+    stats = directory / "stats.json"
+    gateway = h.start("vanishing", [h.binary("rsg_gateway"), "--domain", str(h.domain), "--listen",
+                                    f"127.0.0.1:{free_udp_port()}", "--stats-file", str(stats)])
+    wait_for_stats(stats, lambda s: True, "the gateway to write its stats file")
+    for file in directory.iterdir():
+        file.unlink()
+    directory.rmdir()
+    warning = f"cannot write {stats}.partial: No such file or directory (ENOENT)"
+    err = h.dir / "vanishing.err"
+    wait_for(lambda: warning in err.read_text(), "the stats file warning")
+    time.sleep(2.5)  # two more writes fail the same way
+    check(h.stop("vanishing", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+    check(err.read_text().count("cannot write") == 1, f"the warning was repeated: {err.read_text()}")
 
 
 def shared_memory():

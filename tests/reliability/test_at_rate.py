@@ -4,7 +4,7 @@ the real processes (rsg_sim -> rsg_gateway -> a reliable rsg_echo --json logger)
 Pins that, at five times the robot's nominal rate and with a steady stream of invalid input:
   * the gateway does not crash and publishes no invalid frame;
   * its counters (stats file and status topic) equal what the simulator injected, category by
-    category, with nothing lost, duplicated or reordered beyond the corrupted frames;
+    category, with nothing lost, duplicated or reordered (a corrupted frame is invalid, not also lost);
   * the reliable reader gets every valid frame exactly once, in order, with the values sent.
 
 A small selection (q, robot_mode, time: 79-byte datagrams) keeps the UDP leg and the JSON

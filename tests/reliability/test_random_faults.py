@@ -7,7 +7,7 @@ per frame (2 % each), so they also land next to each other, in bursts and across
 wraps: the cases a periodic schedule never produces. Two seeded runs: frames carrying `time` (the
 tracker orders by time) and frames without it (packet numbers alone).
 
-Pins that, for both, lost = dropped + corrupted, duplicated and reordered equal the simulator's
+Pins that, for both, lost = dropped (a corrupted frame is invalid, not also lost), duplicated and reordered equal the simulator's
 counts, every datagram and every invalid category is counted, and every valid frame is published.
 """
 

@@ -30,12 +30,16 @@ class Participant {
   /// @throws rsg::EnvironmentError when Fast DDS refuses the participant.
   Participant(int domain, const std::string& profile);
   /// Same, then finds the others through `discovery`'s servers or peers instead of multicast.
+  /// A `listener` (e.g. WriterDirectory::listener()) hears discovery from the participant's first
+  /// moment, with StatusMask::none(); it must outlive the participant.
   /// @throws rsg::InputError for an unknown profile or a bad server or peer.
   /// @throws rsg::EnvironmentError when Fast DDS refuses the participant.
-  Participant(int domain, const std::string& profile, const DiscoveryOptions& discovery);
+  Participant(int domain, const std::string& profile, const DiscoveryOptions& discovery,
+              eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr);
   /// Creates the participant from explicit QoS.
   /// @throws rsg::EnvironmentError when Fast DDS refuses the participant.
-  Participant(int domain, const eprosima::fastdds::dds::DomainParticipantQos& qos);
+  Participant(int domain, const eprosima::fastdds::dds::DomainParticipantQos& qos,
+              eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr);
   ~Participant();
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;

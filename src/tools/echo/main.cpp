@@ -30,6 +30,7 @@
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/dds/ros2.hpp"
 #include "rsg/dds/views.hpp"
+#include "rsg/dds/writer_directory.hpp"
 #include "rsg/error.hpp"
 #include "rsg/wire/json.hpp"
 #include "rsg/wire/selection.hpp"
@@ -176,7 +177,9 @@ std::optional<rsg::dds::View> requested_view(const Options& options, const fdds:
 }
 
 int run(const Options& options) {
-  rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery);
+  rsg::dds::WriterDirectory writers;  // what discovery shows, should no writer match
+  rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery,
+                                    writers.listener());
   const std::string topic_name =
       options.ros2 ? rsg::dds::ros2_topic_name(options.ros2_namespace, options.topic) : options.topic;
   fdds::Topic& topic = *participant.robot_state_topic(
@@ -209,7 +212,7 @@ int run(const Options& options) {
   reader_condition.set_enabled_statuses(fdds::StatusMask::data_available()
                                         << fdds::StatusMask::requested_incompatible_qos()
                                         << fdds::StatusMask::subscription_matched());
-  rsg::tools::MatchedWriters matched_writers(read_topic);
+  rsg::tools::MatchedWriters matched_writers(read_topic, writers, options.domain);
   fdds::WaitSet waitset;
   waitset.attach_condition(reader_condition);
   waitset.attach_condition(stop);
@@ -253,6 +256,7 @@ int run(const Options& options) {
         // for a newer sample before or while it was copied; such a copy is no sample at all.
         if (!reader->is_sample_valid(&samples[i], &infos[i])) continue;
         sink.add(values, now);
+        matched_writers.on_sample();
         last_sample = now;
         done = options.count != 0 && ++received == options.count;
       }
@@ -261,6 +265,7 @@ int run(const Options& options) {
     sink.flush(now, done);
     if (done) return kExitOk;
     if (options.timeout_seconds > 0 && now - last_sample >= timeout) {
+      matched_writers.explain_if_unmatched(*reader);
       spdlog::error("no sample on '{}' for {} s", read_topic, options.timeout_seconds);
       return kExitFailure;
     }

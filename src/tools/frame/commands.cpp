@@ -5,11 +5,13 @@
 #include <istream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "rsg/wire/field_table.hpp"
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/hex.hpp"
 #include "rsg/wire/json.hpp"
@@ -38,11 +40,30 @@ void for_each_nonblank_line(std::istream& in, OnLine&& on_line) {
   }
 }
 
-std::string error_line(std::string_view category, std::string_view message) {
+// A selection request read as a state frame fails length_mismatch, on purpose (docs/protocol.md):
+// the bytes a user most likely pasted from the gateway's side. What it asks for, when it is one.
+std::optional<nlohmann::ordered_json> selection_request_of(std::span<const std::uint8_t> bytes) {
+  const wire::SelectionRequestResult request = wire::decode_selection_request(bytes);
+  if (!request) return std::nullopt;
+  nlohmann::ordered_json fields = nlohmann::ordered_json::array();
+  for (const wire::FieldInfo& field : wire::kFields)
+    if (request.selection.contains(field.id())) fields.push_back(field.name);
+  return nlohmann::ordered_json{{"packet_number", request.packet_number},
+                                {"group_select", request.selection.group_select},
+                                {"data_select", request.selection.data_select},
+                                {"fields", std::move(fields)}};
+}
+
+std::string error_line(std::string_view category, std::string_view message,
+                       std::optional<nlohmann::ordered_json> request = std::nullopt) {
   // ordered_json keeps "error" first; replace, not throw, on bytes that are not UTF-8.
-  const nlohmann::ordered_json line = {{"error", category}, {"message", message}};
+  nlohmann::ordered_json line = {{"error", category}, {"message", message}};
+  if (request) line["selection_request"] = std::move(*request);
   return line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
+
+constexpr std::string_view kRequestNote =
+    "these bytes are a selection request (gateway -> robot), not a state frame (robot -> gateway): ";
 
 void write_frame(std::ostream& out, std::span<const std::uint8_t> frame, FrameFormat format) {
   if (format == FrameFormat::kHexLines) {
@@ -76,6 +97,8 @@ int decode_binary(Streams streams) {
   if (!result) {
     streams.err << "error: " << wire::to_string(result.error().category()) << ": " << result.error().message()
                 << '\n';
+    if (const auto request = selection_request_of(bytes))
+      streams.err << "note: " << kRequestNote << request->dump() << '\n';
     return finish(streams, kExitInvalid);
   }
   wire::StateValues values;
@@ -95,7 +118,9 @@ int decode_hex_lines(Streams streams) {
     }
     const wire::DecodeResult result = wire::decode(*bytes);
     if (!result) {
-      streams.out << error_line(wire::to_string(result.error().category()), result.error().message()) << '\n';
+      streams.out << error_line(wire::to_string(result.error().category()), result.error().message(),
+                                selection_request_of(*bytes))
+                  << '\n';
       return true;
     }
     values.assign(result.frame());

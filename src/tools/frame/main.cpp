@@ -78,7 +78,8 @@ int main(int argc, char** argv) {
   auto* decode = app.add_subcommand("decode", "Binary frame, or hex frames one per line -> canonical JSON");
   decode->add_flag("--hex-lines", options.hex_lines,
                    "One hex frame per line; each output line is canonical JSON or "
-                   "{\"error\":CATEGORY,\"message\":...}");
+                   "{\"error\":CATEGORY,\"message\":...}, with \"selection_request\":{...} when the line "
+                   "is a selection request (gateway -> robot) rather than a state frame");
   add_input(*decode, options);
 
   auto* encode = app.add_subcommand(

@@ -267,14 +267,16 @@ int recover(const Options& options) {
 int run(const Options& options, rsg::tools::record::Profile profile) {
   Recording recording(options, profile);  // before DDS: an unwritable path fails at once
 
-  rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery);
+  rsg::dds::WriterDirectory writers;  // what discovery shows, should no writer match
+  rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery,
+                                    writers.listener());
   rsg::tools::MonitorReaders readers(participant, options.topics(), rsg::tools::WakeUp::kPeriodically);
   StopOnSignal stop_on_signal([&readers] { readers.request_stop(); });
 
   const auto start = std::chrono::steady_clock::now();
   const auto duration = std::chrono::duration<double>(options.duration_s);
   LossCounter loss;
-  rsg::tools::MatchedWriters matched_writers(options.topic);
+  rsg::tools::MatchedWriters matched_writers(options.topic, writers, options.domain);
   rsg::RobotState state;
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
@@ -282,6 +284,7 @@ int run(const Options& options, rsg::tools::record::Profile profile) {
   const auto write_what_was_received = [&] {
     while (readers.state().take_next_sample(&state, &info) == rsg::dds::kOk) {
       if (!info.valid_data) continue;
+      matched_writers.on_sample();
       loss.add(info);
       recording.add_state(state, info);
     }

@@ -112,7 +112,9 @@ int run(const Options& options) {
   rsg::tools::view::Server server(options.server, channels.channels(), web_files(options));
   spdlog::info("serving ws://{0}:{1} and http://{0}:{1}/", options.server.host, server.port());
 
-  rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery);
+  rsg::dds::WriterDirectory writers;  // what discovery shows, should no writer match
+  rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery,
+                                    writers.listener());
   rsg::tools::MonitorReaders readers(participant, options.topics());
   StopOnSignal stop_on_signal([&readers] { readers.request_stop(); });
 
@@ -125,12 +127,13 @@ int run(const Options& options) {
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
   bool summary_pending = false;
-  rsg::tools::MatchedWriters matched_writers(options.topic);
+  rsg::tools::MatchedWriters matched_writers(options.topic, writers, options.domain);
   while (!readers.stop_requested()) {
     readers.wait(kWakeUp);
     matched_writers.update(readers.state());
     while (readers.state().take_next_sample(&state, &info) == rsg::dds::kOk) {
       if (!info.valid_data) continue;
+      matched_writers.on_sample();
       const std::uint64_t time = now_ns();
       const auto cdr = payload_of(serializer.serialize(state));
       for (const auto channel : channels.robot_state_cdr()) server.publish(channel, time, cdr);
