@@ -84,10 +84,11 @@ def body(h):
     wait_for_stats(stats, lambda s: s["frames_published"] >= 500 and s["link_up"], "the stream to start")
     stop_at = time.monotonic() + CHURN_S
 
-    # reader_realtime: data-sharing on this host, the common case; reader_realtime_udp where the gateway
-    # is another Fast DDS version (2.9 and 3.x data-sharing on one host abort the writer:
-    # docs/fastdds-versions.md), which tests/fastdds3/run.sh asks for.
-    qos = "reader_realtime_udp" if os.environ.get("RSG_CHURN_UDP_READERS") else "reader_realtime"
+    # reader_realtime_udp: a volatile data-sharing reader that joins a writer while it writes can
+    # abort *itself* on Fast DDS 2.9.1 (ReaderPool::init_shared_segment's assertion, fixed upstream
+    # in PR 4321, 2.13.3; docs/operating.md), once in about a thousand joins here; that is the
+    # reader's failure, not what this test is about.
+    qos = "reader_realtime_udp"
     library = h.start("library", [h.binary("rsg_views_churn"), *domain, "--ros2", "--seconds", str(CHURN_S),
                                   "--hold", "0.5", "--participant-every", "5", "--qos", qos,
                                   *(["--plain"] if CONTROL else [])])
@@ -127,7 +128,9 @@ def body(h):
         thread.start()
     for thread in [*lanes, watcher]:
         thread.join()
-    check(h.wait("library", library, 60) == 0, "the client library's view readers got a sample without their groups")
+    library_status = h.wait("library", library, 60)
+    check(library_status != 1, "the client library's view readers got a sample without their groups")
+    check(library_status == 0, f"rsg_views_churn failed (exit {library_status}): see library.err")
     check(h.wait("rclpy_loop", rclpy_loop, 120) == 0, "an rclpy content-filtered subscription got a wrong message")
 
     check(gateway.poll() is None, f"the gateway died during the churn (exit {gateway.returncode})")

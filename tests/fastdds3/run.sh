@@ -125,7 +125,7 @@ else
       python3 tests/ros2/test_rclpy_$test.py --bin "$gateway3"
   done
   # Filtered readers of every kind joining and leaving a 3.x gateway at 1 kHz (2.9 rsg readers, rclpy 3.2).
-  check views_churn_3_gateway env RSG_DEPS_DIR="${deps:-$checkout/.deps}" RSG_CHURN_UDP_READERS=1 \
+  check views_churn_3_gateway env RSG_DEPS_DIR="${deps:-$checkout/.deps}" \
     python3 tests/dds_views/test_views_churn.py --bin "$gateway3"
 fi
 echo "test-fastdds3: $((SECONDS - start)) s"
