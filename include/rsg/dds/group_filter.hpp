@@ -5,12 +5,12 @@
 // Fast DDS's built-in DDSSQL filter builds a DynamicData of the whole 2 kB sample per sample and
 // per reader. `group_select` is the sample's second byte in every encoding RobotState is written
 // in, so this filter class (kGroupFilterClass) answers the same question with a load and a mask.
-// ViewReader registers it on its participant and uses it for every group view; raw filters
-// (`rsg.view.filter`) stay DDSSQL.
+// ViewReader registers it on its participant (register_group_filter, views.hpp) and uses it for
+// every group view; raw filters (`rsg.view.filter`) stay DDSSQL. This header and its source need no
+// DDS (the fuzzer builds them alone).
 #pragma once
 
 #include <cstdint>
-#include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <span>
 #include <string_view>
 
@@ -30,10 +30,5 @@ wire::Parsed<std::uint8_t> parse_group_filter_expression(std::string_view expres
 /// of `groups` set in group_select. False for a payload too short or in an encoding RobotState is
 /// never written in (parameter lists): a view must not receive a sample it cannot vouch for.
 bool payload_carries_groups(std::span<const std::uint8_t> payload, std::uint8_t groups) noexcept;
-
-/// Makes `participant` evaluate kGroupFilterClass filters: its view readers filter with it, and
-/// its writers can filter for remote readers that use it. Idempotent.
-/// @throws rsg::EnvironmentError when Fast DDS refuses the registration.
-void register_group_filter(eprosima::fastdds::dds::DomainParticipant& participant);
 
 }  // namespace rsg::dds

@@ -22,6 +22,7 @@
 #pragma once
 
 #include <cstdint>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
@@ -82,6 +83,12 @@ View load_view(const eprosima::fastdds::dds::Subscriber& subscriber, const std::
 /// may be evaluating it (a crash, fixed upstream in 3.0), and a DDS-SQL filter costs the writer a
 /// DynamicData per sample per reader: neither may reach the gateway's ingress thread.
 void leave_filtering_to_readers(eprosima::fastdds::dds::DataWriterQos& qos);
+
+/// Makes `participant` evaluate the group filter class (group_filter.hpp): its view readers filter
+/// with it, and its writers can filter for remote readers that use it. ViewReader calls it.
+/// Idempotent.
+/// @throws rsg::EnvironmentError when Fast DDS refuses the registration.
+void register_group_filter(eprosima::fastdds::dds::DomainParticipant& participant);
 
 /// Reads an XML data_reader profile's QoS, with which a reader takes plain samples in place on
 /// either Fast DDS (read_plain_samples_in_place()).
