@@ -110,11 +110,16 @@ wireshark-plugin:
 	mkdir -p "$$dir" && install -m 644 tools/wireshark/rsg_sendbuf.lua "$$dir/" && \
 	echo "installed $$dir/rsg_sendbuf.lua: restart Wireshark, then filter on sendbuf"
 
+# Where the time of a fresh build and of ctest goes (docs/development.md): its own tree, no ccache.
+.PHONY: time-report
+time-report: deps
+	tools/time_report.py --build build-time
+
 format:
 	git ls-files '*.cpp' '*.hpp' '*.h' '*.c' | xargs clang-format -i
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) $(DEMO_BUILD) build-fdds3
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) $(DEMO_BUILD) build-fdds3 build-time
 
 # Fast DDS 3 (Debian 13's 3.1.2) in a cached trixie chroot, and across versions with $(BUILD)'s
 # 2.9.1 on the host (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/.
