@@ -15,25 +15,7 @@ if "${engine[@]}" image inspect "$image" >/dev/null 2>&1; then
   exit 0
 fi
 
-# The first URI that apt uses for SUITE, from one-line (.list) or deb822 (.sources) files.
-apt_uri() {
-  local suite=$1
-  {
-    cat /etc/apt/sources.list /etc/apt/sources.list.d/*.list 2>/dev/null |
-      sed -E 's/\[[^]]*\]//' | awk -v s="$suite" '$1 == "deb" && $3 == s { print $2 }'
-    cat /etc/apt/sources.list.d/*.sources 2>/dev/null |
-      awk -v s="$suite" 'BEGIN { RS = "" } {
-        uri = ""; ok = 0; deb = 0
-        n = split($0, lines, "\n")
-        for (k = 1; k <= n; k++) {
-          if (lines[k] ~ /^Types:/ && lines[k] ~ /[[:space:]]deb([[:space:]]|$)/) deb = 1
-          if (lines[k] ~ /^URIs:/) { split(lines[k], f, /[[:space:]]+/); uri = f[2] }
-          if (lines[k] ~ /^Suites:/) { m = split(lines[k], f, /[[:space:]]+/); for (i = 2; i <= m; i++) if (f[i] == s) ok = 1 }
-          if (lines[k] ~ /^Enabled:[[:space:]]*no/) deb = 0
-        }
-        if (deb && ok && uri != "") print uri }'
-  } | head -n 1
-}
+source "$(dirname "$0")/../tools/apt_sources.sh"  # apt_uri
 mirror=$(apt_uri bookworm)
 [[ -n "$mirror" ]] || { echo "base image: no Debian bookworm source in /etc/apt: which mirror?" >&2; exit 1; }
 security=$(apt_uri bookworm-security)

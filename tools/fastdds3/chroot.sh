@@ -17,7 +17,10 @@
 set -euo pipefail
 checkout=$(cd "$(dirname "$0")/../.." && pwd)
 root=${RSG_TRIXIE_DIR:-$checkout/.deps/trixie}
-mirror=${RSG_TRIXIE_MIRROR:-http://deb.debian.org/debian}
+source "$checkout/tools/apt_sources.sh"  # debian_mirror
+# The Debian mirror the host's apt uses (a Debian 12 host lists bookworm, a 13 host trixie), or
+# RSG_TRIXIE_MIRROR; looked up where it is needed (setup), since `run` and `in` need none.
+mirror=${RSG_TRIXIE_MIRROR:-}
 packages_file=$checkout/docker/packages/trixie.txt
 
 die() { echo "chroot.sh: $*" >&2; exit 1; }
@@ -33,7 +36,9 @@ setup() {
     assert_unmounted "$root.tmp"
     rm -rf "$root.tmp"
     command -v debootstrap >/dev/null || die "debootstrap missing: apt-get install debootstrap"
-    echo "chroot.sh: debootstrap trixie into $root (once)"
+    [[ -n $mirror ]] || mirror=$(debian_mirror trixie bookworm) ||
+      die "no Debian trixie or bookworm source in /etc/apt: which mirror? (RSG_TRIXIE_MIRROR=URI)"
+    echo "chroot.sh: debootstrap trixie into $root from $mirror (once)"
     debootstrap --variant=minbase trixie "$root.tmp" "$mirror" > "$checkout/.deps/trixie-debootstrap.log" 2>&1 ||
       die "debootstrap failed: $checkout/.deps/trixie-debootstrap.log"
     touch "$root.tmp/.rsg-debootstrap"
