@@ -10,6 +10,7 @@
 #include <atomic>
 #include <fstream>
 #include <sstream>
+#include <string>
 
 #include "config.hpp"
 #include "gateway.hpp"
@@ -21,7 +22,6 @@ namespace {
 
 using rsg::gateway::GatewayConfig;
 using rsg::tools::kExitOk;
-using rsg::tools::kExitUsage;
 using rsg::tools::StopOnSignal;
 
 constexpr const char* kRealtimeHelp = R"(Real-time mode applies to the ingress thread (the main thread):
@@ -63,46 +63,23 @@ std::string read_file(const std::string& path) {
   return text.str();
 }
 
-// Flags, then the file under them. Returns the exit status when the process should not go on.
-std::optional<int> parse_command_line(int argc, char** argv, GatewayConfig& config) {
-  std::string config_file;
-  {
-    CLI::App app("rsg_gateway: robot-state frames over UDP <-> RobotState DDS samples", "rsg_gateway");
-    app.footer(kRealtimeHelp);
-    GatewayConfig flags_only;
-    add_config_flags(app, flags_only, config_file);
-    try {
-      app.parse(argc, argv);
-    } catch (const CLI::ParseError& error) {
-      if (error.get_exit_code() == 0) return app.exit(error);  // --help
-      spdlog::error("{} (see --help)", error.what());
-      return kExitUsage;
-    }
-    if (config_file.empty()) {
-      config = std::move(flags_only);
-      return std::nullopt;
-    }
-  }
-
-  std::string text;
-  if (const int status = rsg::tools::run_reporting_errors([&] {
-        text = read_file(config_file);
-        return kExitOk;
-      });
-      status != kExitOk)
-    return status;
-  const rsg::gateway::ConfigResult parsed = rsg::gateway::parse_gateway_config(text);
+// The configuration: the file (--config) with the flags over it, or the flags alone.
+// @throws rsg::InputError when the file cannot be read or does not parse.
+GatewayConfig read_config(const std::string& config_file, const GatewayConfig& flags_only, int argc,
+                          char** argv) {
+  if (config_file.empty()) return flags_only;
+  const rsg::gateway::ConfigResult parsed = rsg::gateway::parse_gateway_config(read_file(config_file));
   if (!parsed) {
     const auto& error = parsed.error();
-    spdlog::error("{}{}: {}", config_file, error.line > 0 ? ":" + std::to_string(error.line) : std::string(),
-                  error.message);
-    return kExitUsage;
+    throw rsg::InputError(config_file + (error.line > 0 ? ":" + std::to_string(error.line) : std::string()) +
+                          ": " + error.message);
   }
-  config = parsed.config();
+  GatewayConfig config = parsed.config();
   CLI::App app("rsg_gateway", "rsg_gateway");
-  add_config_flags(app, config, config_file);
+  std::string ignored;
+  add_config_flags(app, config, ignored);
   app.parse(argc, argv);  // accepted once already
-  return std::nullopt;
+  return config;
 }
 
 }  // namespace
@@ -110,11 +87,15 @@ std::optional<int> parse_command_line(int argc, char** argv, GatewayConfig& conf
 int main(int argc, char** argv) {
   rsg::tools::init_logging("rsg_gateway");
   StopOnSignal::block_stop_signals(/*with_dump=*/true);
-  GatewayConfig config;
-  if (const auto exit_status = parse_command_line(argc, argv, config)) return *exit_status;
-  spdlog::set_level(spdlog::level::from_str(config.log_level));
+  CLI::App app("rsg_gateway: robot-state frames over UDP <-> RobotState DDS samples", "rsg_gateway");
+  app.footer(kRealtimeHelp);
+  GatewayConfig flags_only;
+  std::string config_file;
+  add_config_flags(app, flags_only, config_file);
 
-  return rsg::tools::run_reporting_errors([&] {
+  return rsg::tools::run_main(app, argc, argv, [&] {
+    const GatewayConfig config = read_config(config_file, flags_only, argc, argv);
+    spdlog::set_level(spdlog::level::from_str(config.log_level));
     const rsg::gateway::GatewaySetup setup = rsg::gateway::prepare(config);
     // SIGUSR1 writes the flight recorder's pcap file: the loop does it when it sees `dump`.
     std::atomic<bool> stop{false};

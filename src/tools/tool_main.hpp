@@ -4,10 +4,15 @@
 //
 //   int main(int argc, char** argv) {
 //     rsg::tools::init_logging("rsg_echo");
+//     rsg::tools::StopOnSignal::block_stop_signals();
+//     CLI::App app{...};
 //     ...
-//     if (const auto exit_status = rsg::tools::parse_command_line(app, argc, argv)) return *exit_status;
-//     return rsg::tools::run_reporting_errors([&] { ...; return rsg::tools::kExitOk; });
+//     return rsg::tools::run_main(app, argc, argv, [&] { ...; return rsg::tools::kExitOk; });
 //   }
+//
+// No main catches and maps on its own: a check the command line cannot express is a CLI11 callback
+// (app.final_callback, an option's check) that throws a CLI::ParseError, or setup code in the body
+// that throws rsg::InputError; either way the exit status is 2.
 #pragma once
 
 #include <spdlog/pattern_formatter.h>
@@ -22,14 +27,10 @@
 #include <string_view>
 #include <utility>
 
+#include "exit_status.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::tools {
-
-/// Exit statuses (CONTRIBUTING.md): done, a failure at run time, a usage or input error.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitFailure = 1;
-inline constexpr int kExitUsage = 2;
 
 namespace detail {
 
@@ -64,13 +65,18 @@ inline void init_logging(std::string_view tool) {
 /// and level, "[2026-11-24 23:31:50.262] [rsg_gateway] [info] ...", for a log read afterwards.
 inline void log_with_timestamps() { spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%l] %v"); }
 
-/// Parses the command line; returns the exit status when the tool must stop here (--help: 0, a
-/// parse error: 2, with CLI11's message), or nothing to go on.
+/// Parses the command line; returns the exit status when the tool must stop here (--help: 0, with
+/// the help on stdout; a parse error: 2, logged as "<tool>: <what> (see --help)"), or nothing to go on.
 inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
-    return app.exit(error) == 0 ? kExitOk : kExitUsage;
+    if (error.get_exit_code() == 0) {  // --help
+      app.exit(error);
+      return kExitOk;
+    }
+    spdlog::error("{} (see --help)", error.what());
+    return kExitUsage;
   }
   return std::nullopt;
 }
@@ -93,6 +99,14 @@ int run_reporting_errors(Body&& body) {
     spdlog::error("{}", error.what());
     return exit_status_of(error);
   }
+}
+
+/// The rest of main() once the command line is described: parses it (parse_command_line), then
+/// runs `body`, which returns the exit status, through run_reporting_errors.
+template <class Body>
+int run_main(CLI::App& app, int argc, char** argv, Body&& body) {
+  if (const auto exit_status = parse_command_line(app, argc, argv)) return *exit_status;
+  return run_reporting_errors(std::forward<Body>(body));
 }
 
 }  // namespace rsg::tools

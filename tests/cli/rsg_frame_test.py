@@ -260,11 +260,11 @@ class ExitStatus(unittest.TestCase):
             self.assertEqual(status, 0, args)
             self.assertIn(b"Usage", out)
 
-    def test_unreadable_input_exits_1(self):
+    def test_unreadable_input_exits_2(self):
         for command in (["decode"], ["decode", "--hex-lines"], ["encode"]):
-            status, _, err = run(*command, "/nonexistent/frames")
-            self.assertEqual(status, 1, command)
-            self.assertTrue(err.startswith("error: cannot open '/nonexistent/frames'"), err)
+            status, out, err = run(*command, "/nonexistent/frames")
+            self.assertEqual((status, out), (2, b""), command)
+            self.assertTrue(err.startswith("rsg_frame: cannot open '/nonexistent/frames'"), err)
 
 
 def main():

@@ -286,8 +286,7 @@ int main(int argc, char** argv) {
       "usage error (including an unknown or malformed profile).");
   Options options;
   add_options(app, options);
-  if (const auto stop = parse_command_line(app, argc, argv)) return *stop;
-  return run_reporting_errors([&] {
+  return run_main(app, argc, argv, [&] {
     rsg::dds::load_profiles(options.profiles, options.participant_profile);
     return run(options);
   });

@@ -79,11 +79,11 @@ int finish(Streams streams, int status) {
   streams.out.flush();
   if (!streams.out) {
     streams.err << "error: cannot write the output\n";
-    return kExitInvalid;
+    return kExitFailure;
   }
   if (streams.in.bad()) {
     streams.err << "error: cannot read the input\n";
-    return kExitInvalid;
+    return kExitFailure;
   }
   return status;
 }
@@ -92,14 +92,14 @@ int finish(Streams streams, int status) {
 
 int decode_binary(Streams streams) {
   const std::vector<std::uint8_t> bytes(std::istreambuf_iterator<char>(streams.in), {});
-  if (streams.in.bad()) return finish(streams, kExitInvalid);
+  if (streams.in.bad()) return finish(streams, kExitFailure);
   const wire::DecodeResult result = wire::decode(bytes);
   if (!result) {
     streams.err << "error: " << wire::to_string(result.error().category()) << ": " << result.error().message()
                 << '\n';
     if (const auto request = selection_request_of(bytes))
       streams.err << "note: " << kRequestNote << request->dump() << '\n';
-    return finish(streams, kExitInvalid);
+    return finish(streams, kExitFailure);
   }
   wire::StateValues values;
   values.assign(result.frame());
@@ -139,7 +139,7 @@ int encode_json_lines(Streams streams, FrameFormat format) {
     const wire::Parsed<wire::StateValues> parsed = wire::parse_canonical_json(text);
     if (!parsed) {
       streams.err << "error: line " << number << ": " << parsed.error() << '\n';
-      status = kExitInvalid;
+      status = kExitFailure;
       return false;
     }
     const wire::StateValues& values = *parsed;
@@ -149,7 +149,7 @@ int encode_json_lines(Streams streams, FrameFormat format) {
       streams.err << "error: line " << number
                   << ": cannot encode: " << wire::to_string(result.error.category()) << ": "
                   << result.error.message() << '\n';
-      status = kExitInvalid;
+      status = kExitFailure;
       return false;
     }
     write_frame(streams.out, std::span(frame).first(result.size), format);
@@ -165,7 +165,7 @@ int write_selection_request(Streams streams, std::uint8_t packet_number, const w
   if (!result) {
     streams.err << "error: " << wire::to_string(result.error.category()) << ": " << result.error.message()
                 << '\n';
-    return finish(streams, kExitInvalid);
+    return finish(streams, kExitFailure);
   }
   write_frame(streams.out, std::span(frame).first(result.size), format);
   return finish(streams, kExitOk);

@@ -1,20 +1,16 @@
 // The subcommands of `rsg_frame`, as plain functions from an input stream to output streams, so
-// that argument parsing (main.cpp) and the conversions themselves stay apart.
+// that argument parsing (main.cpp) and the conversions themselves stay apart. Each returns the
+// process's exit status (exit_status.hpp): kExitOk when everything converted (`decode --hex-lines`:
+// the input was readable), kExitFailure for an invalid frame, malformed JSON or hex, or an I/O failure.
 #pragma once
 
 #include <cstdint>
 #include <iosfwd>
 
+#include "exit_status.hpp"
 #include "rsg/wire/selection.hpp"
 
 namespace rsg::tools::frame {
-
-/// Process exit status, the same for every subcommand.
-enum ExitStatus : int {
-  kExitOk = 0,       ///< everything converted (`decode --hex-lines`: the input was readable)
-  kExitInvalid = 1,  ///< an invalid frame, malformed JSON or hex, or an I/O failure
-  kExitUsage = 2,    ///< bad command line
-};
 
 /// How frames are written: raw bytes back to back, or one lowercase hex line per frame.
 enum class FrameFormat { kBinary, kHexLines };

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "rsg/error.hpp"
 #include "tool_main.hpp"
 
 namespace {
@@ -17,15 +18,16 @@ using namespace rsg::tools::frame;
 /// The input a subcommand reads: the named file, or standard input for "-".
 class Input {
  public:
+  /// @throws rsg::InputError when the file cannot be opened.
   explicit Input(const std::string& path) {
     if (path == "-") return;
     file_.open(path, std::ios::binary);
+    if (!file_.is_open()) throw rsg::InputError("cannot open '" + path + "': " + std::strerror(errno));
     stream_ = &file_;
   }
   Input(const Input&) = delete;
   Input& operator=(const Input&) = delete;
 
-  bool is_open() const { return stream_ != &file_ || file_.is_open(); }
   std::istream& stream() { return *stream_; }
 
  private:
@@ -66,13 +68,14 @@ void add_selection(CLI::App& command, Options& options) {
 
 int main(int argc, char** argv) {
   std::ios::sync_with_stdio(false);
+  rsg::tools::init_logging("rsg_frame");
 
   CLI::App app{"Converts SEND_BUF frames (docs/protocol.md) between binary, hex and canonical JSON.",
                "rsg_frame"};
   app.require_subcommand(1);
   app.footer(
       "Exit status: 0 success (decode --hex-lines: the input was readable), 1 invalid frame, malformed "
-      "JSON or hex, or an I/O error, 2 usage error.");
+      "JSON or hex, or an I/O error, 2 usage error or an input file that cannot be opened.");
   Options options;
 
   auto* decode = app.add_subcommand("decode", "Binary frame, or hex frames one per line -> canonical JSON");
@@ -94,20 +97,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   request->add_flag("--hex,--hex-lines", options.hex_lines, "Write one hex line instead of binary");
 
-  if (const auto exit_status = rsg::tools::parse_command_line(app, argc, argv)) return *exit_status;
-
-  const FrameFormat format = options.hex_lines ? FrameFormat::kHexLines : FrameFormat::kBinary;
-  if (request->parsed())
-    return write_selection_request({std::cin, std::cout, std::cerr},
-                                   static_cast<std::uint8_t>(options.packet_number), options.selection,
-                                   format);
-
-  Input input(options.input);
-  if (!input.is_open()) {
-    std::cerr << "error: cannot open '" << options.input << "': " << std::strerror(errno) << '\n';
-    return kExitInvalid;
-  }
-  const Streams streams{input.stream(), std::cout, std::cerr};
-  if (encode->parsed()) return encode_json_lines(streams, format);
-  return options.hex_lines ? decode_hex_lines(streams) : decode_binary(streams);
+  return rsg::tools::run_main(app, argc, argv, [&] {
+    const FrameFormat format = options.hex_lines ? FrameFormat::kHexLines : FrameFormat::kBinary;
+    if (request->parsed())
+      return write_selection_request({std::cin, std::cout, std::cerr},
+                                     static_cast<std::uint8_t>(options.packet_number), options.selection,
+                                     format);
+    Input input(options.input);
+    const Streams streams{input.stream(), std::cout, std::cerr};
+    if (encode->parsed()) return encode_json_lines(streams, format);
+    return options.hex_lines ? decode_hex_lines(streams) : decode_binary(streams);
+  });
 }

@@ -343,30 +343,22 @@ int main(int argc, char** argv) {
       "its end or was cut off, 1 when it is damaged inside.");
   Options options;
   add_options(app, options);
-  if (const auto stop = parse_command_line(app, argc, argv)) return *stop;
-  if (!options.recover.empty()) {
-    if (fs::exists(options.out) && fs::equivalent(options.out, options.recover)) {
-      spdlog::error("--recover writes a new file: --out must be another path");
-      return kExitUsage;
+  return run_main(app, argc, argv, [&] {
+    if (!options.recover.empty()) {
+      if (fs::exists(options.out) && fs::equivalent(options.out, options.recover))
+        throw rsg::InputError("--recover writes a new file: --out must be another path");
+      return recover(options);
     }
-    return run_reporting_errors([&] { return recover(options); });
-  }
-  const auto profile = rsg::tools::record::parse_profile(options.profile);
-  if (!profile) {
-    spdlog::error("--profile must be omgidl or ros2, not '{}'", options.profile);
-    return kExitUsage;
-  }
-  if (*profile == rsg::tools::record::Profile::ros2 && !rsg::tools::record::has_ros2_schemas()) {
-    spdlog::error("this build has no ros2/rsg_msgs/msg/RobotState.msg, so no --profile ros2");
-    return kExitUsage;
-  }
-  if (*profile == rsg::tools::record::Profile::ros2 && !options.status_topic.empty() &&
-      !rsg::tools::record::has_ros2_status_schema())
-    spdlog::warn(
-        "this build has no ros2/rsg_msgs/msg/GatewayStatus.msg, so a --profile ros2 recording leaves "
-        "'{}' out",
-        options.status_topic);
-  return run_reporting_errors([&] {
+    const auto profile = rsg::tools::record::parse_profile(options.profile);
+    if (!profile) throw rsg::InputError("--profile must be omgidl or ros2, not '" + options.profile + "'");
+    if (*profile == rsg::tools::record::Profile::ros2 && !rsg::tools::record::has_ros2_schemas())
+      throw rsg::InputError("this build has no ros2/rsg_msgs/msg/RobotState.msg, so no --profile ros2");
+    if (*profile == rsg::tools::record::Profile::ros2 && !options.status_topic.empty() &&
+        !rsg::tools::record::has_ros2_status_schema())
+      spdlog::warn(
+          "this build has no ros2/rsg_msgs/msg/GatewayStatus.msg, so a --profile ros2 recording leaves "
+          "'{}' out",
+          options.status_topic);
     rsg::dds::load_profiles(options.profiles, options.participant_profile);
     return run(options, *profile);
   });

@@ -298,13 +298,12 @@ int main(int argc, char** argv) {
                "rsg_replay"};
   app.footer(
       "Exit status: 0 when played (a killed recording up to its last whole chunk, with a warning) or on "
-      "SIGINT/SIGTERM, 1 when the file cannot be read or is damaged or a send fails, 2 usage error.");
+      "SIGINT/SIGTERM, 1 when the file is damaged or a send fails, 2 usage error or a file that cannot be "
+      "opened.");
   Options options;
   add_options(app, options);
-  if (const auto stop = parse_command_line(app, argc, argv)) return *stop;
-  if (options.to.empty() && !options.domain) {
-    app.exit(CLI::RequiredError("--to or --domain"));
-    return kExitUsage;
-  }
-  return run_reporting_errors([&] { return run(options); });
+  app.final_callback([&options] {
+    if (options.to.empty() && !options.domain) throw CLI::RequiredError("--to or --domain");
+  });
+  return run_main(app, argc, argv, [&] { return run(options); });
 }

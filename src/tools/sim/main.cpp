@@ -20,7 +20,6 @@ namespace {
 
 using rsg::tools::kExitFailure;
 using rsg::tools::kExitOk;
-using rsg::tools::kExitUsage;
 
 struct Options {
   std::string to;
@@ -209,16 +208,14 @@ int main(int argc, char** argv) {
   Options options;
   rsg::tools::sim::SimConfig config;
   add_options(app, options, config);
-  try {
-    app.parse(argc, argv);
+  // Checks across options, at the end of parsing: a usage error like any other (exit status 2).
+  app.final_callback([&] {
     config.schedule = build_schedule(options);
     check_probabilities(config.faults);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kExitOk : kExitUsage;
-  }
-  config.pause = std::chrono::milliseconds(options.pause_ms);
+    config.pause = std::chrono::milliseconds(options.pause_ms);
+  });
 
-  return rsg::tools::run_reporting_errors([&] {
+  return rsg::tools::run_main(app, argc, argv, [&] {
     if (!options.replay_path.empty()) return run_replay(options);
     const rsg::transport::Endpoint peer = rsg::transport::Endpoint::parse(options.to);
     rsg::transport::UdpSocket socket = rsg::transport::UdpSocket::for_sending_to(peer);

@@ -63,6 +63,9 @@ rsg::tools::view::Payload payload_of(const std::string& text) {
 void add_options(CLI::App& app, Options& options) {
   app.add_option("--listen", options.listen,
                  "HOST:PORT of the WebSocket and HTTP server (0.0.0.0 opens it to other hosts)")
+      ->check([](const std::string& text) {
+        return rsg::transport::parse_host_port(text, rsg::transport::HostPortRule::kBindAddress).error();
+      })
       ->capture_default_str();
   rsg::tools::add_monitor_options(app, options, "serves none");
   app.add_option("--max-clients", options.server.max_clients, "WebSocket clients served at once")
@@ -98,8 +101,7 @@ std::vector<rsg::tools::view::WebFile> web_files(const Options& options) {
 }
 
 void split_listen(const std::string& text, rsg::tools::view::ServerOptions& server) {
-  const rsg::transport::Endpoint endpoint =
-      rsg::transport::Endpoint::parse(text);  // throws std::invalid_argument
+  const rsg::transport::Endpoint endpoint = rsg::transport::Endpoint::parse(text);  // throws rsg::InputError
   std::string host = endpoint.to_string();
   host.resize(host.rfind(':'));
   if (host.size() >= 2 && host.front() == '[') host = host.substr(1, host.size() - 2);
@@ -181,14 +183,8 @@ int main(int argc, char** argv) {
       "Exit status: 0 on SIGINT/SIGTERM, 1 when the port cannot be opened or DDS fails, 2 usage error.");
   Options options;
   add_options(app, options);
-  if (const auto stop = parse_command_line(app, argc, argv)) return *stop;
-  try {
-    split_listen(options.listen, options.server);
-  } catch (const std::exception& error) {
-    spdlog::error("--listen: {}", error.what());
-    return kExitUsage;
-  }
-  return run_reporting_errors([&] {
+  return run_main(app, argc, argv, [&] {
+    split_listen(options.listen, options.server);  // the syntax is checked: a name that does not resolve
     rsg::dds::load_profiles(options.profiles, options.participant_profile);
     return run(options);
   });

@@ -4,6 +4,7 @@
 //   rsg_wireshark_lua TEMPLATE OUTPUT
 //
 // The template holds the dissector's logic; the line @RSG_GENERATED_TABLES@ becomes the tables.
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -84,21 +85,22 @@ std::string tables() {
 
 int main(int argc, char** argv) {
   rsg::tools::init_logging("rsg_wireshark_lua");
-  if (argc != 3) {
-    spdlog::error("usage: rsg_wireshark_lua TEMPLATE OUTPUT");
-    return rsg::tools::kExitUsage;
-  }
-  return rsg::tools::run_reporting_errors([&] {
-    std::ifstream in(argv[1], std::ios::binary);
-    if (!in) throw rsg::InputError(std::string("cannot read '") + argv[1] + "'");
+  CLI::App app{"Writes the Wireshark dissector from its template and the field table.", "rsg_wireshark_lua"};
+  std::string template_path;
+  std::string output_path;
+  app.add_option("TEMPLATE", template_path, "The dissector's template (rsg_sendbuf.lua.in)")->required();
+  app.add_option("OUTPUT", output_path, "The dissector to write")->required();
+  return rsg::tools::run_main(app, argc, argv, [&] {
+    std::ifstream in(template_path, std::ios::binary);
+    if (!in) throw rsg::InputError("cannot read '" + template_path + "'");
     std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     const std::size_t at = text.find(kPlaceholder);
     if (at == std::string::npos)
-      throw rsg::InputError(std::string("'") + argv[1] + "' has no " + std::string(kPlaceholder));
+      throw rsg::InputError("'" + template_path + "' has no " + std::string(kPlaceholder));
     text.replace(at, kPlaceholder.size(), tables());
-    std::ofstream out(argv[2], std::ios::binary | std::ios::trunc);
+    std::ofstream out(output_path, std::ios::binary | std::ios::trunc);
     out << text;
-    if (!out.flush()) throw rsg::EnvironmentError(std::string("cannot write '") + argv[2] + "'");
+    if (!out.flush()) throw rsg::EnvironmentError("cannot write '" + output_path + "'");
     return rsg::tools::kExitOk;
   });
 }
