@@ -103,9 +103,26 @@ std::filesystem::path link_profiles(const std::filesystem::path& project_profile
   return dir;
 }
 
-// For ctest: frames reach a subscriber through the gateway over UDP and by data-sharing (and
-// data-sharing really is used only when asked for), through each floor relay, and to the embedded
-// gateway's callback. Nothing about timing is judged.
+// For ctest: every frame sent reaches a subscriber through the gateway over UDP and by data-sharing
+// (and data-sharing really is used only when asked for), through each floor relay, and to the
+// embedded gateway's callback and its remote DDS reader. Nothing about timing is judged.
+//
+// `received == sent` for each path, and each key it reads must be there: a report that lost a key
+// (a renamed field) fails instead of passing unread.
+bool has_key(const json& report, std::string_view name, const char* key) {
+  if (report.contains(key)) return true;
+  std::cout << "smoke " << name << ": the report has no '" << key << "': " << report.dump() << '\n';
+  return false;
+}
+
+bool all_arrived(const json& counts, std::string_view name) {
+  if (!has_key(counts, name, "sent") || !has_key(counts, name, "received")) return false;
+  const auto sent = counts["sent"].get<std::uint64_t>();
+  const auto received = counts["received"].get<std::uint64_t>();
+  std::cout << "smoke " << name << ": " << received << " of " << sent << " frames arrived\n";
+  return sent > 0 && received == sent;
+}
+
 int run_smoke(BenchOptions options) {
   constexpr double kSmokeRate = 1000;
   constexpr double kSmokeSeconds = 0.3;
@@ -115,29 +132,25 @@ int run_smoke(BenchOptions options) {
   bool ok = true;
   for (const std::string_view transport : {"udp", "datasharing"}) {
     const json run = rsg::bench::run_gateway(options, transport_named(transport));
-    const bool arrived = run["received"].get<std::uint64_t>() > 0;
-    const bool data_sharing_as_asked = run["data_sharing_used"].get<bool>() == (transport == "datasharing");
-    std::cout << "smoke " << transport << ": " << run["received"] << " of " << run["sent"]
-              << " frames arrived, data-sharing "
-              << (run["data_sharing_used"].get<bool>() ? "used" : "not used") << '\n';
-    ok = ok && arrived && data_sharing_as_asked;
+    const bool arrived = all_arrived(run, transport);
+    if (!has_key(run, transport, "data_sharing_used")) {
+      ok = false;
+      continue;
+    }
+    const bool used = run["data_sharing_used"].get<bool>();
+    std::cout << "smoke " << transport << ": data-sharing " << (used ? "used" : "not used") << '\n';
+    ok = ok && arrived && used == (transport == "datasharing");
   }
-  // The floor's relays and Cyclone reader, and the embedded gateway's callback and DDS reader.
-  const std::vector<std::pair<std::string, std::function<json()>>> others = {
-      {"relay_cyclone -> fastdds",
-       [&] { return rsg::bench::run_floor(options, "relay_cyclone", "fastdds"); }},
-      {"relay_fastdds -> cyclone",
-       [&] { return rsg::bench::run_floor(options, "relay_fastdds", "cyclone"); }},
-      {"embedded", [&] { return rsg::bench::run_embedded(options); }},
-  };
-  for (const auto& [name, run_one] : others) {
-    const json run = run_one();
-    const bool reader_got_some =
-        !run.contains("dds_reader") || run["dds_reader"]["received"].get<std::uint64_t>() > 0;
-    std::cout << "smoke " << name << ": " << run["received"] << " of " << run["sent"] << " frames arrived\n";
-    ok = ok && run["received"].get<std::uint64_t>() > 0 && reader_got_some;
-  }
-  return ok ? 0 : 1;
+  // The floor's relays, and the embedded gateway's callback and remote DDS reader.
+  const bool relay_cyclone =
+      all_arrived(rsg::bench::run_floor(options, "relay_cyclone", "fastdds"), "relay_cyclone -> fastdds");
+  const bool relay_fastdds =
+      all_arrived(rsg::bench::run_floor(options, "relay_fastdds", "cyclone"), "relay_fastdds -> cyclone");
+  const json embedded = rsg::bench::run_embedded(options);
+  const bool callback = all_arrived(embedded, "embedded callback");
+  const bool reader = has_key(embedded, "embedded", "dds_reader") &&
+                      all_arrived(embedded["dds_reader"], "embedded dds_reader");
+  return ok && relay_cyclone && relay_fastdds && callback && reader ? 0 : 1;
 }
 
 // The 1, 5 and 15 minute load averages: the record of how busy the shared machine was.
