@@ -20,6 +20,7 @@
 #include <csignal>
 #include <fstream>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -39,6 +40,51 @@ bool may_use_fifo(int priority) {
   rlimit limit{};
   ::getrlimit(RLIMIT_RTPRIO, &limit);
   return has_capability(CAP_SYS_NICE) || limit.rlim_cur >= static_cast<rlim_t>(priority);
+}
+
+bool may_lock_memory() {
+  rlimit limit{};
+  ::getrlimit(RLIMIT_MEMLOCK, &limit);
+  return has_capability(CAP_IPC_LOCK) || limit.rlim_cur == RLIM_INFINITY;
+}
+
+// Takes what real-time mode at `priority` needs where this process may take it: CAP_SYS_NICE and
+// CAP_IPC_LOCK from its permitted set into its effective one (and into the ambient set, so that a
+// child it starts keeps them), else the rtprio and memlock soft limits raised up to their hard ones.
+// Returns "" when the process then has both, else what it lacks and how to get it: the tests that
+// need them fail with that message (CONTRIBUTING.md: a test that cannot test fails, never skips).
+std::string acquire_realtime_privileges(int priority) {
+  __user_cap_header_struct header{_LINUX_CAPABILITY_VERSION_3, 0};
+  __user_cap_data_struct data[_LINUX_CAPABILITY_U32S_3]{};
+  if (::syscall(SYS_capget, &header, data) == 0) {
+    for (const int capability : {CAP_SYS_NICE, CAP_IPC_LOCK}) {
+      auto& word = data[capability / 32];
+      const auto bit = 1U << (capability % 32);
+      if ((word.permitted & bit) != 0) {
+        word.effective |= bit;
+        word.inheritable |= bit;
+      }
+    }
+    if (::syscall(SYS_capset, &header, data) == 0)
+      for (const int capability : {CAP_SYS_NICE, CAP_IPC_LOCK})
+        ::prctl(PR_CAP_AMBIENT, PR_CAP_AMBIENT_RAISE, capability, 0,
+                0);  // fails harmlessly when not permitted
+  }
+  for (const int resource : {RLIMIT_RTPRIO, RLIMIT_MEMLOCK}) {
+    rlimit limit{};
+    if (::getrlimit(resource, &limit) == 0 && limit.rlim_cur != limit.rlim_max) {
+      limit.rlim_cur = limit.rlim_max;
+      ::setrlimit(resource, &limit);
+    }
+  }
+  std::string missing;
+  if (!may_use_fifo(priority))
+    missing += "no CAP_SYS_NICE and an rtprio limit below " + std::to_string(priority) + "; ";
+  if (!may_lock_memory()) missing += "no CAP_IPC_LOCK and a memlock limit that is not unlimited; ";
+  if (missing.empty()) return missing;
+  return "cannot test real-time mode, this process (uid " + std::to_string(::getuid()) + ") has " + missing +
+         "run the test as root, in a container with --cap-add SYS_NICE --cap-add IPC_LOCK, or with "
+         "`USER - rtprio 99` and `USER - memlock unlimited` in /etc/security/limits.conf";
 }
 
 // What the calling process is left with after losing the privileges real-time mode needs: no
@@ -78,8 +124,7 @@ TEST(Realtime, NothingRequestedChangesNothing) {
 }
 
 TEST(Realtime, WithPrivilegesTheThreadRunsFifoOnItsCpuWithMemoryLocked) {
-  if (!may_use_fifo(kPriority) || !has_capability(CAP_IPC_LOCK))
-    GTEST_SKIP() << "needs CAP_SYS_NICE and CAP_IPC_LOCK (run as root or in a container with them)";
+  if (const std::string missing = acquire_realtime_privileges(kPriority); !missing.empty()) FAIL() << missing;
   // On a thread of its own, so that the test runner itself stays an ordinary thread.
   RealtimeOutcome outcome;
   int policy = -1;
@@ -249,8 +294,7 @@ TEST(RealtimeGateway, WithoutPrivilegesAndWithAnImpossibleCpuItWarnsOnceAndRuns)
 }
 
 TEST(RealtimeGateway, WithPrivilegesOnlyTheIngressThreadRunsFifo) {
-  if (!may_use_fifo(kPriority) || !has_capability(CAP_IPC_LOCK))
-    GTEST_SKIP() << "needs CAP_SYS_NICE and CAP_IPC_LOCK (run as root or in a container with them)";
+  if (const std::string missing = acquire_realtime_privileges(kPriority); !missing.empty()) FAIL() << missing;
   GatewayProcess gateway(gateway_flags("0"), /*unprivileged=*/false);
   ASSERT_TRUE(
       gateway.wait_for("real-time mode: ingress thread SCHED_FIFO priority 50, memory locked, on CPU 0",
