@@ -61,9 +61,8 @@ const std::array kKeys = {
     ConfigKey{"allow-from", "Accept frames only from ADDR[/PREFIX] (repeatable; IPv4 or IPv6)",
               &GatewayConfig::allow_from,
               [](const GatewayConfig& c) {
-                std::string error;
                 for (const auto& network : c.allow_from)
-                  if (!is_valid_network(network, error)) return error;
+                  if (const auto parsed = parse_network(network); !parsed) return parsed.error();
                 return std::string();
               }},
     ConfigKey{"topic", "Topic the received frames are published on", &GatewayConfig::topic,

@@ -186,8 +186,9 @@ GatewaySetup prepare(const GatewayConfig& config) {
     ingress.listen = resolve("listen", config.listen);
     ingress.receive_buffer = config.receive_buffer;
     for (const auto& network : config.allow_from) {
-      std::string error;
-      if (!ingress.sources.allow(network, error)) throw InputError("--allow-from: " + error);
+      const wire::Parsed<Network> parsed = parse_network(network);
+      if (!parsed) throw InputError("--allow-from: " + parsed.error());
+      ingress.sources.allow(*parsed);
     }
     ingress.topic = dds_topic(config, config.topic);
     ingress.type_name = state_type_name(config);

@@ -31,17 +31,14 @@ bool prefix_matches(const std::array<std::uint8_t, 16>& a, const std::array<std:
   return (a[whole_bytes] & mask) == (b[whole_bytes] & mask);
 }
 
-struct ParsedNetwork {
-  std::array<std::uint8_t, 16> address;
-  unsigned prefix_bits;
-};
+}  // namespace
 
-std::optional<ParsedNetwork> parse_network(std::string_view text, std::string& error) {
+wire::Parsed<Network> parse_network(std::string_view text) {
   const std::size_t slash = text.find('/');
   std::string host(text.substr(0, slash));
   if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
 
-  ParsedNetwork parsed{};
+  Network parsed{};
   unsigned max_bits = 0;
   unsigned offset_bits = 0;
   in_addr ipv4{};
@@ -54,40 +51,25 @@ std::optional<ParsedNetwork> parse_network(std::string_view text, std::string& e
     std::memcpy(parsed.address.data(), &ipv6, 16);
     max_bits = 128;
   } else {
-    error = "'" + std::string(text) + "' is not an IPv4 or IPv6 address (ADDR or ADDR/PREFIX)";
-    return std::nullopt;
+    return wire::ParseFailure{"'" + std::string(text) +
+                              "' is not an IPv4 or IPv6 address (ADDR or ADDR/PREFIX)"};
   }
 
   unsigned bits = max_bits;
   if (slash != std::string_view::npos) {
-    const std::string_view prefix = text.substr(slash + 1);
-    const std::optional<unsigned> number = wire::parse_number<unsigned>(prefix);
-    if (number) bits = *number;
-    if (!number || bits > max_bits) {
-      error = "'" + std::string(text) + "': prefix must be a number 0.." + std::to_string(max_bits);
-      return std::nullopt;
-    }
+    const std::optional<unsigned> number = wire::parse_number<unsigned>(text.substr(slash + 1));
+    if (!number || *number > max_bits)
+      return wire::ParseFailure{"'" + std::string(text) + "': prefix must be a number 0.." +
+                                std::to_string(max_bits)};
+    bits = *number;
   }
   parsed.prefix_bits = offset_bits + bits;
   return parsed;
 }
 
-}  // namespace
-
-bool is_valid_network(std::string_view network, std::string& error) {
-  return parse_network(network, error).has_value();
-}
-
-bool SourceFilter::allow(std::string_view network, std::string& error) {
-  const auto parsed = parse_network(network, error);
-  if (!parsed) return false;
-  networks_.push_back({parsed->address, parsed->prefix_bits});
-  return true;
-}
-
 bool SourceFilter::allows(const sockaddr* source) const noexcept {
   if (networks_.empty()) return true;
-  Address address{};
+  std::array<std::uint8_t, 16> address{};
   if (source->sa_family == AF_INET) {
     address = mapped_ipv4(reinterpret_cast<const sockaddr_in*>(source)->sin_addr);
   } else if (source->sa_family == AF_INET6) {

@@ -12,12 +12,24 @@
 #include <string_view>
 #include <vector>
 
+#include "rsg/wire/parsed.hpp"
+
 namespace rsg::gateway {
+
+/// A network as an IPv6 prefix (an IPv4 one IPv4-mapped).
+struct Network {
+  std::array<std::uint8_t, 16> address;
+  unsigned prefix_bits;
+};
+
+/// Parses an `--allow-from` value, "ADDR" (a single host) or "ADDR/PREFIX", IPv4 or IPv6.
+/// @return the network, or what is wrong with `text`.
+wire::Parsed<Network> parse_network(std::string_view text);
 
 class SourceFilter {
  public:
-  /// Adds "ADDR" (a single host) or "ADDR/PREFIX". On failure returns false and says why in `error`.
-  bool allow(std::string_view network, std::string& error);
+  /// Accepts frames from `network` too.
+  void allow(const Network& network) { networks_.push_back(network); }
 
   /// True when no network was added (everyone is allowed) or `source` lies in one of them.
   bool allows(const sockaddr* source) const noexcept;
@@ -25,16 +37,7 @@ class SourceFilter {
   bool allows_everyone() const { return networks_.empty(); }
 
  private:
-  using Address = std::array<std::uint8_t, 16>;
-  struct Network {
-    Address address;
-    unsigned prefix_bits;
-  };
-
   std::vector<Network> networks_;
 };
-
-/// Checks the syntax of an `--allow-from` value without keeping it.
-bool is_valid_network(std::string_view network, std::string& error);
 
 }  // namespace rsg::gateway

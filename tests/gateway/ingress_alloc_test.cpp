@@ -105,8 +105,9 @@ class IngressAllocation : public ::testing::Test {
     Ingress::Options options;
     options.listen = transport::Endpoint::parse("127.0.0.1:0");
     options.receive_buffer = 4 << 20;
-    std::string error;
-    EXPECT_TRUE(options.sources.allow("127.0.0.0/8", error)) << error;  // a filter that is consulted
+    const wire::Parsed<Network> loopback = parse_network("127.0.0.0/8");
+    EXPECT_TRUE(loopback) << loopback.error();
+    if (loopback) options.sources.allow(*loopback);  // a filter that is consulted
     options.topic = topic_;
     options.type_name = type_name_;
     options.rate_topics = rate_topics_;

@@ -13,8 +13,11 @@ bool allows(const SourceFilter& filter, const char* host_port) {
 
 SourceFilter filter_of(std::initializer_list<const char*> networks) {
   SourceFilter filter;
-  std::string error;
-  for (const char* network : networks) EXPECT_TRUE(filter.allow(network, error)) << network << ": " << error;
+  for (const char* network : networks) {
+    const wire::Parsed<Network> parsed = parse_network(network);
+    EXPECT_TRUE(parsed) << network << ": " << parsed.error();
+    if (parsed) filter.allow(*parsed);
+  }
   return filter;
 }
 
@@ -69,11 +72,9 @@ TEST(SourceFilter, ZeroPrefixAllowsTheWholeFamily) {
 
 TEST(SourceFilter, RejectsMalformedNetworksWithAReason) {
   for (const char* bad : {"", "host.example", "10.0.0.1/33", "10.0.0.1/", "10.0.0.1/x", "::1/129", "1.2.3"}) {
-    std::string error;
-    SourceFilter filter;
-    EXPECT_FALSE(filter.allow(bad, error)) << bad;
-    EXPECT_FALSE(error.empty()) << bad;
-    EXPECT_TRUE(filter.allows_everyone());
+    const wire::Parsed<Network> parsed = parse_network(bad);
+    EXPECT_FALSE(parsed) << bad;
+    EXPECT_FALSE(parsed.error().empty()) << bad;
   }
 }
 
