@@ -5,6 +5,7 @@
 
 #include "group_bytes.hpp"
 #include "rsg/wire/number.hpp"
+#include "rsg/wire/text.hpp"
 
 namespace rsg::wire {
 namespace {
@@ -16,9 +17,7 @@ std::string for_each_item(std::string_view list, OnItem&& on_item) {
   if (list.empty()) return "empty list";
   while (true) {
     const std::size_t comma = list.find(',');
-    std::string_view item = list.substr(0, comma);
-    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
-    while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
+    const std::string_view item = trim(list.substr(0, comma));
     if (std::string why = on_item(item); !why.empty()) return why;
     if (comma == std::string_view::npos) return {};
     list.remove_prefix(comma + 1);

@@ -18,10 +18,9 @@ std::vector<wire::Selection> selections() {
   std::vector<wire::Selection> result;
   for (const char* items :
        {"all", "q", "g0", "g5", "g3,g4", "current_errors,last_motion_errors", "O_T_EE,time"}) {
-    wire::Selection selection;
-    std::string error;
-    EXPECT_TRUE(parse_selection_items(items, selection, error)) << error;
-    result.push_back(selection);
+    const wire::Parsed<wire::Selection> selection = parse_selection_items(items);
+    EXPECT_TRUE(selection) << selection.error();
+    result.push_back(selection ? *selection : wire::Selection{});
   }
   result.push_back(wire::Selection{});
   return result;

@@ -52,8 +52,9 @@ SimReport run(Simulator& sim, CapturingSink& sink, std::uint64_t frames) {
 SimConfig config_with(const char* every) {
   SimConfig config;
   config.schedule = Schedule();
-  std::string error;
-  EXPECT_TRUE(config.schedule.add(every, error)) << error;
+  const wire::Parsed<Schedule::Entry> entry = parse_schedule_entry(every);
+  EXPECT_TRUE(entry) << entry.error();
+  if (entry) config.schedule.add(*entry);
   return config;
 }
 
@@ -84,8 +85,9 @@ TEST(Simulator, AboveOneKilohertzTimeRepeatsWholeMilliseconds) {
 
 TEST(Simulator, FollowsTheSchedulePerFrame) {
   SimConfig config = config_with("1:q");
-  std::string error;
-  ASSERT_TRUE(config.schedule.add("4:g5", error));
+  const wire::Parsed<Schedule::Entry> entry = parse_schedule_entry("4:g5");
+  ASSERT_TRUE(entry) << entry.error();
+  config.schedule.add(*entry);
   Simulator sim(config);
   CapturingSink sink;
   run(sim, sink, 9);

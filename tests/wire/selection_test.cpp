@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "rsg/wire/frame.hpp"
+#include "rsg/wire/text.hpp"
 
 namespace rsg {
 namespace {
@@ -36,6 +37,29 @@ TEST(Selection, ParsesFieldAndGroupLists) {
   const wire::Parsed<std::uint8_t> mask = wire::parse_group_mask("0, 2");
   ASSERT_TRUE(mask) << mask.error();
   EXPECT_EQ(*mask, 0b101);
+}
+
+TEST(Selection, TheUnionHoldsTheFieldsAndGroupsOfBoth) {
+  const wire::Selection joints = *wire::parse_field_list("q,dq");
+  const wire::Selection group5 = *wire::parse_group_list("5");
+  const wire::Selection both = joints | group5;
+  EXPECT_TRUE(both.contains(wire::Field::q) && both.contains(wire::Field::dq));
+  EXPECT_EQ(both.group_select, joints.group_select | group5.group_select);
+  EXPECT_EQ(both.data_bytes(), joints.data_bytes() + group5.data_bytes());
+  EXPECT_EQ(both | joints, both);
+  EXPECT_EQ(joints | wire::Selection{}, joints);
+  wire::Selection grown = joints;
+  grown |= wire::Selection::all();
+  EXPECT_EQ(grown, wire::Selection::all());
+}
+
+TEST(Selection, ListItemsAreTrimmedOfAnyWhiteSpace) {
+  const wire::Parsed<wire::Selection> fields = wire::parse_field_list(" q,\tdq\r\n");
+  ASSERT_TRUE(fields) << fields.error();
+  EXPECT_EQ(*fields, *wire::parse_field_list("q,dq"));
+  EXPECT_EQ(wire::trim(" \t x y \r\n\v\f"), "x y");
+  EXPECT_EQ(wire::trim(" \t "), "");
+  EXPECT_EQ(wire::trim(""), "");
 }
 
 TEST(SelectionRequest, RoundTripsAndIsRejectedByTheStateDecoder) {

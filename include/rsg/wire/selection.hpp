@@ -44,6 +44,16 @@ struct Selection {
   /// Bytes of the data section this selection implies.
   std::uint16_t data_bytes() const;
 
+  /// Selects every field of `other` too: the union.
+  constexpr Selection& operator|=(const Selection& other) {
+    group_select = static_cast<std::uint8_t>(group_select | other.group_select);
+    for (std::size_t group = 0; group < kGroupCount; ++group)
+      data_select[group] = static_cast<std::uint8_t>(data_select[group] | other.data_select[group]);
+    return *this;
+  }
+  /// The fields of both selections.
+  friend constexpr Selection operator|(Selection a, const Selection& b) { return a |= b; }
+
   friend constexpr bool operator==(const Selection&, const Selection&) = default;
 };
 

@@ -16,17 +16,10 @@
 #include "rsg/wire/hex.hpp"
 #include "rsg/wire/json.hpp"
 #include "rsg/wire/state_values.hpp"
+#include "rsg/wire/text.hpp"
 
 namespace rsg::tools::frame {
 namespace {
-
-constexpr std::string_view kWhitespace = " \t\r\n\v\f";
-
-std::string_view trim(std::string_view text) {
-  const std::size_t first = text.find_first_not_of(kWhitespace);
-  if (first == std::string_view::npos) return {};
-  return text.substr(first, text.find_last_not_of(kWhitespace) - first + 1);
-}
 
 /// Calls `on_line(number, text)` for every line that is not blank; `number` counts from 1 and
 /// includes blank lines, so that it matches what an editor shows. Stops when `on_line` is false.
@@ -35,7 +28,7 @@ void for_each_nonblank_line(std::istream& in, OnLine&& on_line) {
   std::size_t number = 0;
   for (std::string line; std::getline(in, line);) {
     ++number;
-    const std::string_view text = trim(line);
+    const std::string_view text = wire::trim(line);
     if (!text.empty() && !on_line(number, text)) return;
   }
 }

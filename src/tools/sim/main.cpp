@@ -67,22 +67,21 @@ Report (--report FILE, and a summary on stderr):
    "restarts","pauses","selection_requests","invalid_requests","send_failures","longest_gap_us"}
   sent = valid + all invalid (datagrams on the wire, a duplicate counted twice).)";
 
-bool parse_categories(const std::string& list, std::vector<rsg::wire::ErrorCategory>& out,
-                      std::string& error) {
-  out.clear();
+/// Parses --corrupt-categories' comma-separated list of docs/protocol.md's error categories.
+/// @return the categories, or a failure naming the one that is not.
+rsg::wire::Parsed<std::vector<rsg::wire::ErrorCategory>> parse_categories(const std::string& list) {
+  std::vector<rsg::wire::ErrorCategory> categories;
   std::size_t begin = 0;
   while (begin <= list.size()) {
     const std::size_t comma = std::min(list.find(',', begin), list.size());
     const std::string name = list.substr(begin, comma - begin);
     const auto category = rsg::wire::parse_error_category(name);
-    if (!category || *category == rsg::wire::ErrorCategory::kNone) {
-      error = "'" + name + "' is not an error category of docs/protocol.md";
-      return false;
-    }
-    out.push_back(*category);
+    if (!category || *category == rsg::wire::ErrorCategory::kNone)
+      return rsg::wire::ParseFailure{"'" + name + "' is not an error category of docs/protocol.md"};
+    categories.push_back(*category);
     begin = comma + 1;
   }
-  return true;
+  return categories;
 }
 
 void add_options(CLI::App& app, Options& options, rsg::tools::sim::SimConfig& config) {
@@ -102,8 +101,7 @@ void add_options(CLI::App& app, Options& options, rsg::tools::sim::SimConfig& co
         [&options, parse, name](const std::string& list) {
           const rsg::wire::Parsed<rsg::wire::Selection> selection = parse(list);
           if (!selection) throw CLI::ValidationError(name, selection.error());
-          options.base_selection =
-              rsg::tools::sim::unite(options.base_selection.value_or(rsg::wire::Selection{}), *selection);
+          options.base_selection = options.base_selection.value_or(rsg::wire::Selection{}) | *selection;
         },
         help);
   };
@@ -129,9 +127,9 @@ void add_options(CLI::App& app, Options& options, rsg::tools::sim::SimConfig& co
   faults->add_option_function<std::string>(
       "--corrupt-categories",
       [&fault](const std::string& list) {
-        std::string error;
-        if (!parse_categories(list, fault.corrupt_categories, error))
-          throw CLI::ValidationError("--corrupt-categories", error);
+        auto categories = parse_categories(list);
+        if (!categories) throw CLI::ValidationError("--corrupt-categories", categories.error());
+        fault.corrupt_categories = std::move(categories).value();
       },
       "Comma-separated categories that corruptions cycle through (default: all seven)");
   auto* pause_after =
@@ -182,9 +180,11 @@ int run_replay(const Options& options) {
 rsg::tools::sim::Schedule build_schedule(const Options& options) {
   rsg::tools::sim::Schedule schedule;
   if (options.base_selection) schedule.add(1, *options.base_selection);
-  for (const std::string& entry : options.every) {
-    std::string error;
-    if (!schedule.add(entry, error)) throw CLI::ValidationError("--every", error);
+  for (const std::string& spec : options.every) {
+    const rsg::wire::Parsed<rsg::tools::sim::Schedule::Entry> entry =
+        rsg::tools::sim::parse_schedule_entry(spec);
+    if (!entry) throw CLI::ValidationError("--every", entry.error());
+    schedule.add(*entry);
   }
   if (schedule.empty()) schedule.add(1, rsg::wire::Selection::all());
   return schedule;

@@ -10,16 +10,15 @@
 #include <string_view>
 #include <vector>
 
+#include "rsg/wire/parsed.hpp"
 #include "rsg/wire/selection.hpp"
 
 namespace rsg::tools::sim {
 
-/// Bitwise union: the fields of both selections.
-wire::Selection unite(const wire::Selection& a, const wire::Selection& b);
-
 /// Parses a comma-separated list whose items are field names ("q") or group tokens ("g2"), or the
-/// word "all". On failure returns false and names the offending item in `error`.
-bool parse_selection_items(std::string_view list, wire::Selection& out, std::string& error);
+/// word "all".
+/// @return the union of the items, or a failure naming the offending item.
+wire::Parsed<wire::Selection> parse_selection_items(std::string_view list);
 
 /// A set of (period, selection) entries. Frame k carries the union of the selections whose period
 /// divides k, so frame 0 carries every entry; a frame that no entry covers carries no field (a valid,
@@ -38,8 +37,7 @@ class Schedule {
   void add(std::uint64_t period, const wire::Selection& selection) {
     entries_.push_back({period, selection});
   }
-  /// Adds an entry written "N:LIST" (N >= 1, LIST as parse_selection_items takes it).
-  bool add(std::string_view spec, std::string& error);
+  void add(const Entry& entry) { entries_.push_back(entry); }
 
   wire::Selection at(std::uint64_t frame) const;
   bool empty() const { return entries_.empty(); }
@@ -48,5 +46,9 @@ class Schedule {
  private:
   std::vector<Entry> entries_;
 };
+
+/// Parses an entry written "N:LIST" (N >= 1, LIST as parse_selection_items takes it).
+/// @return the entry, or a failure naming what is wrong with `spec`.
+wire::Parsed<Schedule::Entry> parse_schedule_entry(std::string_view spec);
 
 }  // namespace rsg::tools::sim
