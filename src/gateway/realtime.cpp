@@ -6,6 +6,8 @@
 #include <sys/resource.h>
 
 #include <cerrno>
+#include <optional>
+#include <string>
 #include <system_error>
 
 namespace rsg::gateway {
@@ -35,39 +37,32 @@ std::string allowed_cpus() {
   return text;
 }
 
-void add(std::string& problems, const std::string& problem) {
-  problems += (problems.empty() ? "" : "; ") + problem;
-}
+// Each step below returns what was refused, and why; nothing when it was done.
+using Refusal = std::optional<std::string>;
 
-bool pin(int cpu, std::string& problems) {
-  if (cpu >= CPU_SETSIZE) {
-    add(problems, "CPU " + std::to_string(cpu) + " not pinned: beyond the " + std::to_string(CPU_SETSIZE) +
-                      " CPUs Linux's affinity calls can name");
-    return false;
-  }
+Refusal pin(int cpu) {
+  if (cpu >= CPU_SETSIZE)
+    return "CPU " + std::to_string(cpu) + " not pinned: beyond the " + std::to_string(CPU_SETSIZE) +
+           " CPUs Linux's affinity calls can name";
   cpu_set_t set;
   CPU_ZERO(&set);
   CPU_SET(cpu, &set);
-  if (const int error = ::pthread_setaffinity_np(::pthread_self(), sizeof set, &set); error != 0) {
-    add(problems, "CPU " + std::to_string(cpu) + " not pinned: " + describe(error) +
-                      " (this process may run on CPUs " + allowed_cpus() + ")");
-    return false;
-  }
-  return true;
+  if (const int error = ::pthread_setaffinity_np(::pthread_self(), sizeof set, &set); error != 0)
+    return "CPU " + std::to_string(cpu) + " not pinned: " + describe(error) +
+           " (this process may run on CPUs " + allowed_cpus() + ")";
+  return std::nullopt;
 }
 
-bool lock_memory(std::string& problems) {
+Refusal lock_memory() {
   // MCL_FUTURE as well: Fast DDS and the loaned samples may still map memory after start-up.
-  if (::mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-    add(problems, "memory not locked: mlockall: " + describe(errno) +
-                      " (needs CAP_IPC_LOCK or a memlock limit above the process's size; the limit is " +
-                      limit_text(RLIMIT_MEMLOCK) + " bytes)");
-    return false;
-  }
-  return true;
+  if (::mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+    return "memory not locked: mlockall: " + describe(errno) +
+           " (needs CAP_IPC_LOCK or a memlock limit above the process's size; the limit is " +
+           limit_text(RLIMIT_MEMLOCK) + " bytes)";
+  return std::nullopt;
 }
 
-bool make_fifo(int priority, std::string& problems) {
+Refusal make_fifo(int priority) {
   sched_param parameters{};
   parameters.sched_priority = priority;
   if (const int error = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &parameters); error != 0) {
@@ -78,22 +73,27 @@ bool make_fifo(int priority, std::string& problems) {
     else if (error == EINVAL)
       why += " (SCHED_FIFO priorities are " + std::to_string(::sched_get_priority_min(SCHED_FIFO)) + ".." +
              std::to_string(::sched_get_priority_max(SCHED_FIFO)) + ")";
-    add(problems, "SCHED_FIFO priority " + std::to_string(priority) + " refused: " + why);
-    return false;
+    return "SCHED_FIFO priority " + std::to_string(priority) + " refused: " + why;
   }
-  return true;
+  return std::nullopt;
 }
 
 }  // namespace
 
 RealtimeOutcome enter_realtime(const RealtimeRequest& request) {
   RealtimeOutcome outcome;
-  if (request.cpu >= 0) outcome.pinned = pin(request.cpu, outcome.problems);
+  // True when the step was done; else its refusal joins the outcome's problems.
+  const auto done = [&outcome](const Refusal& refusal) {
+    if (!refusal) return true;
+    outcome.problems += (outcome.problems.empty() ? "" : "; ") + *refusal;
+    return false;
+  };
+  if (request.cpu >= 0) outcome.pinned = done(pin(request.cpu));
   if (request.priority > 0) {
     // Memory first: faulting in every page of the process takes a while and should not run at
     // real-time priority, ahead of everything else on that CPU.
-    outcome.locked = lock_memory(outcome.problems);
-    outcome.fifo = make_fifo(request.priority, outcome.problems);
+    outcome.locked = done(lock_memory());
+    outcome.fifo = done(make_fifo(request.priority));
   }
   return outcome;
 }
