@@ -16,13 +16,13 @@ namespace rsg::capture {
 /// The UDP datagrams of a pcap or pcapng file, in file order, with nanosecond timestamps.
 class PcapReader {
  public:
-  /// Throws std::runtime_error naming the file and libpcap's reason.
+  /// @throws rsg::InputError naming the file and libpcap's reason, or the link type it cannot read.
   explicit PcapReader(const std::string& path);
   /// Reads from an open stream and closes it when done (tests and the fuzzer read from memory).
   explicit PcapReader(std::FILE* stream);
 
-  /// The next UDP datagram; nothing at the end of the file. Throws std::runtime_error on a damaged
-  /// file (libpcap stops there).
+  /// The next UDP datagram; nothing at the end of the file.
+  /// @throws rsg::InputError on a damaged or cut file (libpcap stops there).
   std::optional<UdpPacket> next();
   int linktype() const { return linktype_; }
 
@@ -42,13 +42,13 @@ class PcapReader {
 /// timestamps: what tcpdump, tshark and Wireshark all read.
 class PcapWriter {
  public:
-  /// Throws std::runtime_error naming the file.
+  /// @throws rsg::EnvironmentError naming the file.
   explicit PcapWriter(const std::string& path);
 
   /// False when the packet cannot be encoded (payload too large, mixed IP versions). Write errors
   /// show at `flush`.
   bool write(const UdpPacket& packet);
-  /// Throws std::runtime_error when anything written so far did not reach the file.
+  /// @throws rsg::EnvironmentError when anything written so far did not reach the file.
   void flush();
 
  private:

@@ -35,7 +35,8 @@ class Egress {
     std::vector<transport::Endpoint> destinations;
   };
 
-  /// Creates the reader and the sockets, then starts the thread. Throws std::runtime_error.
+  /// Creates the reader and the sockets, then starts the thread.
+  /// @throws rsg::EnvironmentError when DDS or the kernel refuses the reader or a socket.
   Egress(dds::Participant& participant, const Options& options);
   /// Stops the thread, then deletes the reader.
   ~Egress();

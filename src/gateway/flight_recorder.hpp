@@ -49,7 +49,7 @@ class FlightRecorder {
               std::chrono::system_clock::time_point now);
 
   /// Writes the datagrams of the last `window` before the newest one, oldest first, to
-  /// DIR/rsg_flight_<UTC time>_<N>_<reason>.pcap. Throws std::runtime_error when it cannot.
+  /// DIR/rsg_flight_<UTC time>_<N>_<reason>.pcap. @throws rsg::EnvironmentError when it cannot.
   Dump dump(std::string_view reason);
 
  private:

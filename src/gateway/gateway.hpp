@@ -24,13 +24,15 @@ struct GatewaySetup {
   std::optional<Egress::Options> egress;
 };
 
-/// Resolves and checks everything that can be checked without creating entities. Throws
-/// std::runtime_error with a message naming the flag, file or profile at fault.
+/// Resolves and checks everything that can be checked without creating entities.
+/// @throws rsg::InputError with a message naming the flag, file or profile at fault.
 GatewaySetup prepare(const GatewayConfig& config);
 
 class Gateway {
  public:
-  /// Binds, creates the DDS entities and starts egress. Throws std::runtime_error / std::system_error.
+  /// Binds, creates the DDS entities and starts egress.
+  /// @throws rsg::EnvironmentError when the kernel or DDS refuses (a port that is taken, an entity),
+  /// rsg::InputError for a view or profile that turns out unusable.
   explicit Gateway(const GatewaySetup& setup);
 
   /// Receives, publishes and reports until `stop` is set, then writes the final status. Whenever

@@ -45,7 +45,9 @@ class Ros2StandardTopics {
     bool any() const { return joint_states || tf || external_wrench; }
   };
 
-  /// Creates the writers in `publisher` and starts the publishing thread. Throws std::runtime_error.
+  /// Creates the writers in `publisher` and starts the publishing thread.
+  /// @throws rsg::InputError for a configuration it cannot publish (joint_states without 7 joint
+  /// names), rsg::EnvironmentError when DDS refuses a writer.
   Ros2StandardTopics(dds::Participant& participant, eprosima::fastdds::dds::Publisher& publisher,
                      Options options);
   /// Stops the thread (what is queued is still written), then deletes the writers.

@@ -52,7 +52,9 @@ struct ReadLimits {
 /// Visits every schema, channel and message of `file` (messages inside chunks too) in file order.
 ScanResult scan(std::span<const std::uint8_t> file, RecordVisitor& visitor, const ReadLimits& limits = {});
 
-/// A whole file in memory, read-only (mmap). Throws std::runtime_error naming the file.
+/// A whole file in memory, read-only (mmap).
+/// @throws rsg::InputError naming the file when it cannot be opened, rsg::EnvironmentError when
+/// it cannot be mapped.
 class MappedFile {
  public:
   explicit MappedFile(const std::filesystem::path& path);

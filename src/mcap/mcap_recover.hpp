@@ -23,8 +23,9 @@ struct RecoverResult {
 };
 
 /// Writes what `damaged` holds to `out` (profile and library from its header; `options` for the
-/// rest). Throws WriteError when `out` cannot be written, std::runtime_error when `damaged` has no
-/// header (not MCAP).
+/// rest).
+/// @throws WriteError (an rsg::EnvironmentError) when `out` cannot be written, rsg::InputError when
+/// `damaged` has no header (not MCAP).
 RecoverResult recover(std::span<const std::uint8_t> damaged, const std::filesystem::path& out,
                       WriterOptions options);
 

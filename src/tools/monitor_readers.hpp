@@ -36,7 +36,8 @@ struct MonitorTopics {
 /// The readers belong to `participant`'s subscriber, which must outlive this object.
 class MonitorReaders {
  public:
-  /// Throws ViewError for an unusable view profile, std::runtime_error when Fast DDS refuses a reader.
+  /// @throws rsg::dds::ViewError for an unusable view profile, rsg::EnvironmentError when Fast DDS
+  /// refuses a reader.
   MonitorReaders(dds::Participant& participant, const MonitorTopics& topics, WakeUp wake = WakeUp::kOnData) {
     namespace fdds = eprosima::fastdds::dds;
     fdds::Topic& topic = *participant.robot_state_topic(topics.topic);

@@ -28,8 +28,8 @@ struct ReplayReport {
 
 /// Sends the payload of every UDP datagram to the chosen port in `path` to `to`, in file order, the
 /// first one at once and each other one as long after it as the capture says (divided by `speed`).
-/// Invalid frames are sent as they are: a replay reproduces what the robot sent. Throws
-/// std::runtime_error for an unreadable file or one without a SEND_BUF frame to find the port by.
+/// Invalid frames are sent as they are: a replay reproduces what the robot sent.
+/// @throws rsg::InputError for an unreadable file or one without a SEND_BUF frame to find the port by.
 ReplayReport replay(const std::string& path, transport::UdpSocket& socket, const transport::Endpoint& to,
                     const ReplayOptions& options, const std::atomic<bool>& stop);
 

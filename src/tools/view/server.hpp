@@ -46,7 +46,9 @@ struct ChannelCount {
 
 class Server {
  public:
-  /// Binds and starts serving; throws std::runtime_error when the address cannot be bound.
+  /// Binds and starts serving.
+  /// @throws rsg::InputError when the host is no IP address, rsg::EnvironmentError when the address
+  /// cannot be bound.
   Server(const ServerOptions& options, std::vector<foxglove::Channel> channels, std::vector<WebFile> files);
   ~Server();
   Server(const Server&) = delete;
