@@ -99,9 +99,9 @@ else
   publish3=$(mixed publish3 rsg_views_publish)
   gateway_echo3=$(mixed gateway_echo3 rsg_gateway rsg_echo)
   # Views, content filters included: 3.x readers on a 2.9 writer's stream, and 2.9 readers on 3.x's.
-  check views_2.9_writer_3_readers python3 tests/dds_views/echo_views_test.py --echo "$echo3/rsg_echo" \
+  check views_2.9_writer_3_readers python3 tests/dds/echo_views_test.py --echo "$echo3/rsg_echo" \
     --publish "$host_build/bin/rsg_views_publish" -v
-  check views_3_writer_2.9_readers python3 tests/dds_views/echo_views_test.py --echo "$host_build/bin/rsg_echo" \
+  check views_3_writer_2.9_readers python3 tests/dds/echo_views_test.py --echo "$host_build/bin/rsg_echo" \
     --publish "$publish3/rsg_views_publish" -v
   # The pipeline: a 3.x gateway read by 2.9's rsg_echo, a 2.9 gateway read by 3.x's, values exact.
   check sim_to_echo_3_gateway_2.9_echo python3 tests/integration/test_sim_to_echo.py --bin "$gateway3"
@@ -126,7 +126,7 @@ else
   done
   # Filtered readers of every kind joining and leaving a 3.x gateway at 1 kHz (2.9 rsg readers, rclpy 3.2).
   check views_churn_3_gateway env RSG_DEPS_DIR="${deps:-$checkout/.deps}" \
-    python3 tests/dds_views/test_views_churn.py --bin "$gateway3"
+    python3 tests/dds/test_views_churn.py --bin "$gateway3"
 fi
 echo "test-fastdds3: $((SECONDS - start)) s"
 echo "test-fastdds3: $passed passed, $failed failed"
