@@ -2,7 +2,7 @@
 """End-to-end tests of the rsg_frame command line against the conformance vectors.
 
 Run by ctest (label `cli`); by hand:
-    tests/cli/rsg_frame_test.py --tool build/bin/rsg_frame --vectors tests/data/vectors [-v]
+    tests/tools/frame/rsg_frame_test.py --tool build/bin/rsg_frame --vectors tests/data/vectors [-v]
 Standard library only.
 """
 
