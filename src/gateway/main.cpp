@@ -1,6 +1,6 @@
 // rsg_gateway: raw SEND_BUF frames over UDP <-> RobotState DDS samples. See gateway.hpp.
 //
-// Exit status (src/tools/tool_main.hpp, as every rsg executable): 0 after SIGINT/SIGTERM, 2 when the
+// Exit status (src/app/tool_main.hpp, as every rsg executable): 0 after SIGINT/SIGTERM, 2 when the
 // configuration (flags, file, profiles, addresses) is unusable, 1 when the machine refuses (the port
 // is taken, DDS refuses an entity); nothing is left running then. A refused real-time setting
 // (--rt-priority, --cpu) is a warning, not a failure.

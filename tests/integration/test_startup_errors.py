@@ -1,6 +1,6 @@
 """Bad flags, files and profiles: one message naming the problem, exit status 2, and nothing
 started (the listening port is still free). A port another process holds is the machine's refusal,
-not a usage error: exit status 1, for the gateway and a tool alike (src/tools/tool_main.hpp).
+not a usage error: exit status 1, for the gateway and a tool alike (src/app/tool_main.hpp).
 Also: --allow-from rejects other senders."""
 
 import json

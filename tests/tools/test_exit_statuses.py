@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Every rsg executable exits as CONTRIBUTING.md ("Errors") writes it, through the one main()
-skeleton (src/tools/tool_main.hpp): --help is 0 with the usage on stdout; a flag it does not know
+skeleton (src/app/tool_main.hpp): --help is 0 with the usage on stdout; a flag it does not know
 is 2, one line on stderr, "<tool>: <what> (see --help)" (what CLI11 finds first: an unknown flag or
 a missing required one); an input file that does not exist is 2 too
 (rsg::InputError), and nothing is started.

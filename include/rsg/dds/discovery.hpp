@@ -1,6 +1,6 @@
 // How a participant finds the others when multicast is not there: a Fast DDS Discovery Server,
 // or a fixed list of unicast peers. Every rsg program takes both as options
-// (`--discovery-server`, `--peer`; src/tools/discovery_cli.hpp) and applies them to the QoS of
+// (`--discovery-server`, `--peer`; src/app/discovery_cli.hpp) and applies them to the QoS of
 // its participant profile:
 //
 //   rsg::dds::DiscoveryOptions discovery;
