@@ -2,7 +2,7 @@
 // glue, not rsg's API, so that CLI11 stays out of the installed headers:
 //
 //   rsg::dds::DiscoveryOptions discovery;
-//   rsg::tools::add_discovery_options(app, discovery);
+//   rsg::app::add_discovery_options(app, discovery);
 //   ...
 //   rsg::dds::Participant participant(domain, profile, discovery);
 #pragma once
@@ -11,7 +11,7 @@
 
 #include "rsg/dds/discovery.hpp"
 
-namespace rsg::tools {
+namespace rsg::app {
 
 inline void add_discovery_options(CLI::App& app, dds::DiscoveryOptions& options) {
   // CLI11 takes "" for a good value: exactly what a failed Parsed says, and a good one.
@@ -24,4 +24,4 @@ inline void add_discovery_options(CLI::App& app, dds::DiscoveryOptions& options)
       ->check(each(transport::parse_peer));
 }
 
-}  // namespace rsg::tools
+}  // namespace rsg::app

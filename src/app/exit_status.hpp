@@ -2,7 +2,7 @@
 // without the rest of the main() skeleton (tool_main.hpp), such as rsg_frame's conversions.
 #pragma once
 
-namespace rsg::tools {
+namespace rsg::app {
 
 /// Done: --count reached, --help, SIGINT or SIGTERM.
 inline constexpr int kExitOk = 0;
@@ -11,4 +11,4 @@ inline constexpr int kExitFailure = 1;
 /// A usage error: bad flags, or an rsg::InputError (file, profile, view, address).
 inline constexpr int kExitUsage = 2;
 
-}  // namespace rsg::tools
+}  // namespace rsg::app

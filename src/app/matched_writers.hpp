@@ -28,7 +28,7 @@
 
 #include "rsg/dds/writer_directory.hpp"
 
-namespace rsg::tools {
+namespace rsg::app {
 
 class MatchedWriters {
  public:
@@ -106,4 +106,4 @@ class MatchedWriters {
   bool silence_said_ = false;
 };
 
-}  // namespace rsg::tools
+}  // namespace rsg::app

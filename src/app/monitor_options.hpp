@@ -12,7 +12,7 @@
 #include "rsg/dds/discovery.hpp"
 #include "rsg/dds/profiles.hpp"
 
-namespace rsg::tools {
+namespace rsg::app {
 
 struct MonitorOptions {
   int domain = 0;
@@ -47,4 +47,4 @@ inline void add_monitor_options(CLI::App& app, MonitorOptions& options, const st
   add_discovery_options(app, options.discovery);
 }
 
-}  // namespace rsg::tools
+}  // namespace rsg::app

@@ -19,7 +19,7 @@
 #include "rsg/dds/views.hpp"
 #include "rsg/error.hpp"
 
-namespace rsg::tools {
+namespace rsg::app {
 
 /// When wait() returns: as soon as a sample arrives (a live view), or only when its timeout passes
 /// (a recorder that takes samples in batches and so wakes once per batch, not once per sample).
@@ -90,4 +90,4 @@ class MonitorReaders {
   eprosima::fastdds::dds::WaitSet waitset_;  // last: detached before the conditions go
 };
 
-}  // namespace rsg::tools
+}  // namespace rsg::app

@@ -9,7 +9,7 @@
 #include "recording_schemas.hpp"
 #include "rsg/dds/detail/fastdds_compat.hpp"
 
-namespace rsg::tools::record {
+namespace rsg::app {
 namespace {
 
 std::span<const std::uint8_t> bytes_of(std::string_view text) {
@@ -122,4 +122,4 @@ bool CdrSerializer::deserialize(std::span<const std::uint8_t> bytes, RobotState&
   }
 }
 
-}  // namespace rsg::tools::record
+}  // namespace rsg::app

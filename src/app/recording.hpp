@@ -21,7 +21,7 @@
 
 #include "mcap_writer.hpp"
 
-namespace rsg::tools::record {
+namespace rsg::app {
 
 enum class Profile { omgidl, ros2 };
 
@@ -70,4 +70,4 @@ class CdrSerializer {
   std::unique_ptr<Types> types_;
 };
 
-}  // namespace rsg::tools::record
+}  // namespace rsg::app

@@ -11,7 +11,7 @@
 #include <stop_token>
 #include <thread>
 
-namespace rsg::tools {
+namespace rsg::app {
 
 class StopOnSignal {
  public:
@@ -54,4 +54,4 @@ class StopOnSignal {
   std::jthread thread_;
 };
 
-}  // namespace rsg::tools
+}  // namespace rsg::app

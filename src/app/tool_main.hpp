@@ -3,11 +3,11 @@
 // time (1) the same way for all, and every line on stderr says which program wrote it.
 //
 //   int main(int argc, char** argv) {
-//     rsg::tools::init_logging("rsg_echo");
-//     rsg::tools::StopOnSignal::block_stop_signals();
+//     rsg::app::init_logging("rsg_echo");
+//     rsg::app::StopOnSignal::block_stop_signals();
 //     CLI::App app{...};
 //     ...
-//     return rsg::tools::run_main(app, argc, argv, [&] { ...; return rsg::tools::kExitOk; });
+//     return rsg::app::run_main(app, argc, argv, [&] { ...; return rsg::app::kExitOk; });
 //   }
 //
 // No main catches and maps on its own: a check the command line cannot express is a CLI11 callback
@@ -30,7 +30,7 @@
 #include "exit_status.hpp"
 #include "rsg/error.hpp"
 
-namespace rsg::tools {
+namespace rsg::app {
 
 namespace detail {
 
@@ -109,4 +109,4 @@ int run_main(CLI::App& app, int argc, char** argv, Body&& body) {
   return run_reporting_errors(std::forward<Body>(body));
 }
 
-}  // namespace rsg::tools
+}  // namespace rsg::app

@@ -20,9 +20,9 @@
 
 namespace {
 
+using rsg::app::kExitOk;
+using rsg::app::StopOnSignal;
 using rsg::gateway::GatewayConfig;
-using rsg::tools::kExitOk;
-using rsg::tools::StopOnSignal;
 
 constexpr const char* kRealtimeHelp = R"(Real-time mode applies to the ingress thread (the main thread):
   --rt-priority N  SCHED_FIFO at N needs CAP_SYS_NICE or `USER - rtprio N` in
@@ -85,7 +85,7 @@ GatewayConfig read_config(const std::string& config_file, const GatewayConfig& f
 }  // namespace
 
 int main(int argc, char** argv) {
-  rsg::tools::init_logging("rsg_gateway");
+  rsg::app::init_logging("rsg_gateway");
   StopOnSignal::block_stop_signals(/*with_dump=*/true);
   CLI::App app("rsg_gateway: robot-state frames over UDP <-> RobotState DDS samples", "rsg_gateway");
   app.footer(kRealtimeHelp);
@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
   std::string config_file;
   add_config_flags(app, flags_only, config_file);
 
-  return rsg::tools::run_main(app, argc, argv, [&] {
+  return rsg::app::run_main(app, argc, argv, [&] {
     const GatewayConfig config = read_config(config_file, flags_only, argc, argv);
     spdlog::set_level(spdlog::level::from_str(config.log_level));
     const rsg::gateway::GatewaySetup setup = rsg::gateway::prepare(config);
@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
     std::atomic<bool> dump{false};
     const StopOnSignal signals([&stop] { stop = true; }, [&dump] { dump = true; });
     rsg::gateway::Gateway gateway(setup);
-    rsg::tools::log_with_timestamps();  // started: from here on a log of a running service
+    rsg::app::log_with_timestamps();  // started: from here on a log of a running service
     rsg::gateway::enter_realtime_mode(config);
     gateway.run(stop, &dump);
     return kExitOk;

@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
       ->add_option("--participant-profile", read_options.participant_profile,
                    "XML participant profile, e.g. rsg_participant_multicast")
       ->capture_default_str();
-  rsg::tools::add_discovery_options(*reader, read_options.discovery);
+  rsg::app::add_discovery_options(*reader, read_options.discovery);
   CLI11_PARSE(app, argc, argv);
   try {
     return sender->parsed() ? send(send_options) : read(read_options);

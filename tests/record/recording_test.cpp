@@ -12,7 +12,7 @@
 #include "rsg/dds/robot_state.hpp"
 #include "vectors.hpp"
 
-namespace rsg::tools::record {
+namespace rsg::app {
 namespace {
 
 std::string read_text(const std::string& path) {
@@ -68,4 +68,4 @@ TEST(RecordingCdr, ShortOrForeignPayloadsAreRefused) {
 }
 
 }  // namespace
-}  // namespace rsg::tools::record
+}  // namespace rsg::app

@@ -42,7 +42,7 @@ namespace {
 namespace fdds = eprosima::fastdds::dds;
 using rsg::tools::echo::Clock;
 
-using namespace rsg::tools;  // exit statuses
+using namespace rsg::app;  // the main skeleton and the exit statuses
 
 // The table is redrawn at most this often, and the timeout checked as often.
 constexpr auto kRefreshPeriod = std::chrono::milliseconds(100);
@@ -64,7 +64,7 @@ struct Options {
   rsg::dds::DiscoveryOptions discovery;
 };
 
-using rsg::tools::StopOnSignal;
+using rsg::app::StopOnSignal;
 
 const char* policy_name(fdds::QosPolicyId_t id) {
   switch (id) {
@@ -164,7 +164,7 @@ void add_options(CLI::App& app, Options& options) {
   app.add_option("--participant-profile", options.participant_profile,
                  "XML participant profile, e.g. rsg_secure_reader under DDS Security")
       ->capture_default_str();
-  rsg::tools::add_discovery_options(app, options.discovery);
+  rsg::app::add_discovery_options(app, options.discovery);
 }
 
 /// What the reader reads: a view, or the whole topic.
@@ -212,7 +212,7 @@ int run(const Options& options) {
   reader_condition.set_enabled_statuses(fdds::StatusMask::data_available()
                                         << fdds::StatusMask::requested_incompatible_qos()
                                         << fdds::StatusMask::subscription_matched());
-  rsg::tools::MatchedWriters matched_writers(read_topic, writers, options.domain);
+  rsg::app::MatchedWriters matched_writers(read_topic, writers, options.domain);
   fdds::WaitSet waitset;
   waitset.attach_condition(reader_condition);
   waitset.attach_condition(stop);
@@ -275,7 +275,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  rsg::tools::init_logging("rsg_echo");
+  rsg::app::init_logging("rsg_echo");
   StopOnSignal::block_stop_signals();  // before Fast DDS starts threads (stop_on_signal.hpp)
   CLI::App app{"Prints the RobotState samples of a topic, or of a group view of it.", "rsg_echo"};
   app.footer(

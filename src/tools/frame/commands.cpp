@@ -21,6 +21,9 @@
 namespace rsg::tools::frame {
 namespace {
 
+using app::kExitFailure;
+using app::kExitOk;
+
 /// Calls `on_line(number, text)` for every line that is not blank; `number` counts from 1 and
 /// includes blank lines, so that it matches what an editor shows. Stops when `on_line` is false.
 template <class OnLine>

@@ -68,7 +68,7 @@ void add_selection(CLI::App& command, Options& options) {
 
 int main(int argc, char** argv) {
   std::ios::sync_with_stdio(false);
-  rsg::tools::init_logging("rsg_frame");
+  rsg::app::init_logging("rsg_frame");
 
   CLI::App app{"Converts SEND_BUF frames (docs/protocol.md) between binary, hex and canonical JSON.",
                "rsg_frame"};
@@ -97,7 +97,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   request->add_flag("--hex,--hex-lines", options.hex_lines, "Write one hex line instead of binary");
 
-  return rsg::tools::run_main(app, argc, argv, [&] {
+  return rsg::app::run_main(app, argc, argv, [&] {
     const FrameFormat format = options.hex_lines ? FrameFormat::kHexLines : FrameFormat::kBinary;
     if (request->parsed())
       return write_selection_request({std::cin, std::cout, std::cerr},

@@ -30,16 +30,16 @@ namespace {
 
 namespace fdds = eprosima::fastdds::dds;
 namespace fs = std::filesystem;
-using rsg::tools::StopOnSignal;
+using rsg::app::StopOnSignal;
 
-using namespace rsg::tools;  // exit statuses
+using namespace rsg::app;  // the main skeleton and the exit statuses
 
 // The recorder takes what has arrived every 10 ms instead of waking for each sample: a recording
 // needs no low latency, and a thousand thread wake-ups a second were most of its CPU at 1 kHz. The
 // reader's history (reader_logger: 5000 samples) holds far more than 10 ms at any rate rsg reaches.
 constexpr auto kBatchPeriod = std::chrono::milliseconds(10);
 
-struct Options : rsg::tools::MonitorOptions {
+struct Options : rsg::app::MonitorOptions {
   fs::path out;
   std::string profile;  // MCAP flavour: "" (omgidl) or "ros2"
   double duration_s = 0;
@@ -58,7 +58,7 @@ std::uint64_t now_ns() {
 /// One MCAP file after another (with --split-size), each complete with its own schemas and channels.
 class Recording {
  public:
-  Recording(const Options& options, rsg::tools::record::Profile profile)
+  Recording(const Options& options, rsg::app::Profile profile)
       : options_(options),
         profile_(profile),
         split_bytes_(static_cast<std::uint64_t>(options.split_mb * 1e6)) {
@@ -131,12 +131,11 @@ class Recording {
 
   void open() {
     const fs::path path = next_path();
-    writer_.emplace(
-        path, rsg::mcap::WriterOptions{.profile = std::string(rsg::tools::record::header_profile(profile_)),
-                                       .library = "rsg_record",
-                                       .chunk_bytes = options_.chunk_bytes,
-                                       .sync = options_.fsync});
-    channels_ = rsg::tools::record::add_channels(*writer_, profile_, options_.topic, options_.status_topic);
+    writer_.emplace(path, rsg::mcap::WriterOptions{.profile = std::string(rsg::app::header_profile(profile_)),
+                                                   .library = "rsg_record",
+                                                   .chunk_bytes = options_.chunk_bytes,
+                                                   .sync = options_.fsync});
+    channels_ = rsg::app::add_channels(*writer_, profile_, options_.topic, options_.status_topic);
     ++files;
     if (split_bytes_ != 0) spdlog::info("writing {}", path.string());
   }
@@ -187,11 +186,11 @@ class Recording {
   }
 
   const Options& options_;
-  rsg::tools::record::Profile profile_;
+  rsg::app::Profile profile_;
   std::uint64_t split_bytes_;
   std::optional<rsg::mcap::Writer> writer_;
-  rsg::tools::record::Channels channels_;
-  rsg::tools::record::CdrSerializer serializer_;
+  rsg::app::Channels channels_;
+  rsg::app::CdrSerializer serializer_;
   std::vector<Pending> batch_;
   std::vector<std::uint8_t> batch_bytes_;
   std::uint64_t last_log_time_ = 0;
@@ -216,7 +215,7 @@ class LossCounter {
 
 void add_options(CLI::App& app, Options& options) {
   app.add_option("--out", options.out, "MCAP file to write")->required();
-  rsg::tools::add_monitor_options(app, options, "records none");
+  rsg::app::add_monitor_options(app, options, "records none");
   app.add_option("--profile", options.profile,
                  "MCAP flavour: omgidl (default: rsg's IDL, for Foxglove) or ros2 (ros2msg schemas and the "
                  "channel metadata rosbag2 expects)");
@@ -264,19 +263,19 @@ int recover(const Options& options) {
   return kExitOk;
 }
 
-int run(const Options& options, rsg::tools::record::Profile profile) {
+int run(const Options& options, rsg::app::Profile profile) {
   Recording recording(options, profile);  // before DDS: an unwritable path fails at once
 
   rsg::dds::WriterDirectory writers;  // what discovery shows, should no writer match
   rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery,
                                     writers.listener());
-  rsg::tools::MonitorReaders readers(participant, options.topics(), rsg::tools::WakeUp::kPeriodically);
+  rsg::app::MonitorReaders readers(participant, options.topics(), rsg::app::WakeUp::kPeriodically);
   StopOnSignal stop_on_signal([&readers] { readers.request_stop(); });
 
   const auto start = std::chrono::steady_clock::now();
   const auto duration = std::chrono::duration<double>(options.duration_s);
   LossCounter loss;
-  rsg::tools::MatchedWriters matched_writers(options.topic, writers, options.domain);
+  rsg::app::MatchedWriters matched_writers(options.topic, writers, options.domain);
   rsg::RobotState state;
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
@@ -333,7 +332,7 @@ int run(const Options& options, rsg::tools::record::Profile profile) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  rsg::tools::init_logging("rsg_record");
+  rsg::app::init_logging("rsg_record");
   StopOnSignal::block_stop_signals();  // before Fast DDS starts threads (stop_on_signal.hpp)
   CLI::App app{"Records RobotState and GatewayStatus samples into an MCAP file.", "rsg_record"};
   app.footer(
@@ -349,12 +348,12 @@ int main(int argc, char** argv) {
         throw rsg::InputError("--recover writes a new file: --out must be another path");
       return recover(options);
     }
-    const auto profile = rsg::tools::record::parse_profile(options.profile);
+    const auto profile = rsg::app::parse_profile(options.profile);
     if (!profile) throw rsg::InputError("--profile must be omgidl or ros2, not '" + options.profile + "'");
-    if (*profile == rsg::tools::record::Profile::ros2 && !rsg::tools::record::has_ros2_schemas())
+    if (*profile == rsg::app::Profile::ros2 && !rsg::app::has_ros2_schemas())
       throw rsg::InputError("this build has no ros2/rsg_msgs/msg/RobotState.msg, so no --profile ros2");
-    if (*profile == rsg::tools::record::Profile::ros2 && !options.status_topic.empty() &&
-        !rsg::tools::record::has_ros2_status_schema())
+    if (*profile == rsg::app::Profile::ros2 && !options.status_topic.empty() &&
+        !rsg::app::has_ros2_status_schema())
       spdlog::warn(
           "this build has no ros2/rsg_msgs/msg/GatewayStatus.msg, so a --profile ros2 recording leaves "
           "'{}' out",

@@ -35,9 +35,9 @@ namespace {
 
 namespace fdds = eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
-using rsg::tools::StopOnSignal;
+using rsg::app::StopOnSignal;
 
-using namespace rsg::tools;  // exit statuses
+using namespace rsg::app;  // the main skeleton and the exit statuses
 
 // Sleeps are cut into slices so that a stop request ends a long pause promptly.
 constexpr auto kLongestSleep = std::chrono::milliseconds(50);
@@ -142,7 +142,7 @@ class Player final : public rsg::mcap::RecordVisitor {
       state_channels_.insert(channel.id);
   }
   void on_schema(const rsg::mcap::Schema& schema) override {
-    if (rsg::tools::record::is_robot_state_schema(schema.name)) state_schemas_.insert(schema.id);
+    if (rsg::app::is_robot_state_schema(schema.name)) state_schemas_.insert(schema.id);
   }
   bool on_message(const rsg::mcap::Message& message) override {
     if (!state_channels_.contains(message.channel_id)) return !stop_;
@@ -201,7 +201,7 @@ class Player final : public rsg::mcap::RecordVisitor {
   double speed_;
   const std::atomic<bool>& stop_;
   std::unordered_set<std::uint16_t> state_schemas_, state_channels_;
-  rsg::tools::record::CdrSerializer serializer_;
+  rsg::app::CdrSerializer serializer_;
   rsg::RobotState sample_;
   std::optional<std::uint64_t> first_time_;      // publish time of the pass's first sample
   std::optional<Clock::time_point> pass_start_;  // when the pass's first sample is due
@@ -225,7 +225,7 @@ void add_options(CLI::App& app, Options& options) {
       ->default_str(rsg::dds::default_profiles_dir().string());
   app.add_option("--participant-profile", options.participant_profile, "XML participant profile")
       ->capture_default_str();
-  rsg::tools::add_discovery_options(app, options.discovery);
+  rsg::app::add_discovery_options(app, options.discovery);
   app.add_option("--speed", options.speed, "Play this many times faster than recorded")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -292,7 +292,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  rsg::tools::init_logging("rsg_replay");
+  rsg::app::init_logging("rsg_replay");
   StopOnSignal::block_stop_signals();  // before Fast DDS starts threads (stop_on_signal.hpp)
   CLI::App app{"Plays an rsg_record MCAP file back as raw frames (--to) or DDS samples (--domain).",
                "rsg_replay"};

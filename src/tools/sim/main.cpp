@@ -18,8 +18,8 @@
 
 namespace {
 
-using rsg::tools::kExitFailure;
-using rsg::tools::kExitOk;
+using rsg::app::kExitFailure;
+using rsg::app::kExitOk;
 
 struct Options {
   std::string to;
@@ -168,7 +168,7 @@ int run_replay(const Options& options) {
   const rsg::transport::Endpoint peer = rsg::transport::Endpoint::parse(options.to);
   rsg::transport::UdpSocket socket = rsg::transport::UdpSocket::for_sending_to(peer);
   std::atomic<bool> stop{false};
-  const rsg::tools::StopOnSignal signals([&stop] { stop = true; });
+  const rsg::app::StopOnSignal signals([&stop] { stop = true; });
   const rsg::tools::sim::ReplayReport report =
       rsg::tools::sim::replay(options.replay_path, socket, peer, options.replay, stop);
   spdlog::info("replayed {} datagrams to port {} ({} complete passes, {} send failures)", report.sent,
@@ -199,8 +199,8 @@ void check_probabilities(const rsg::tools::sim::FaultConfig& faults) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  rsg::tools::init_logging("rsg_sim");
-  rsg::tools::StopOnSignal::block_stop_signals();
+  rsg::app::init_logging("rsg_sim");
+  rsg::app::StopOnSignal::block_stop_signals();
   CLI::App app{"Simulated Franka Panda: streams SEND_BUF frames (docs/protocol.md) over UDP.", "rsg_sim"};
   app.footer(std::string(kScheduleHelp) +
              "\n\nRuns until --count/--duration or SIGINT/SIGTERM. Exit status: 0 success, 1 runtime "
@@ -215,7 +215,7 @@ int main(int argc, char** argv) {
     config.pause = std::chrono::milliseconds(options.pause_ms);
   });
 
-  return rsg::tools::run_main(app, argc, argv, [&] {
+  return rsg::app::run_main(app, argc, argv, [&] {
     if (!options.replay_path.empty()) return run_replay(options);
     const rsg::transport::Endpoint peer = rsg::transport::Endpoint::parse(options.to);
     rsg::transport::UdpSocket socket = rsg::transport::UdpSocket::for_sending_to(peer);
@@ -239,7 +239,7 @@ int main(int argc, char** argv) {
           std::chrono::duration<double>(*options.duration_s));
 
     std::atomic<bool> stop{false};
-    const rsg::tools::StopOnSignal signals([&stop] { stop = true; });
+    const rsg::app::StopOnSignal signals([&stop] { stop = true; });
     spdlog::info("sending to {} at {} Hz", peer.to_string(), config.rate_hz);
     rsg::tools::sim::stream(sim, link, limits, stop);
 

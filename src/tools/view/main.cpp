@@ -33,14 +33,14 @@
 namespace {
 
 namespace fdds = eprosima::fastdds::dds;
-using rsg::tools::StopOnSignal;
+using rsg::app::StopOnSignal;
 
-using namespace rsg::tools;  // exit statuses
+using namespace rsg::app;  // the main skeleton and the exit statuses
 
 constexpr auto kWakeUp = std::chrono::milliseconds(20);
 constexpr auto kPageRepeat = std::chrono::seconds(1);
 
-struct Options : rsg::tools::MonitorOptions {
+struct Options : rsg::app::MonitorOptions {
   std::string listen = "127.0.0.1:8765";
   double page_rate_hz = 30;
   std::string chart_js = RSG_CHART_JS;
@@ -67,7 +67,7 @@ void add_options(CLI::App& app, Options& options) {
         return rsg::transport::parse_host_port(text, rsg::transport::HostPortRule::kBindAddress).error();
       })
       ->capture_default_str();
-  rsg::tools::add_monitor_options(app, options, "serves none");
+  rsg::app::add_monitor_options(app, options, "serves none");
   app.add_option("--max-clients", options.server.max_clients, "WebSocket clients served at once")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
@@ -117,19 +117,19 @@ int run(const Options& options) {
   rsg::dds::WriterDirectory writers;  // what discovery shows, should no writer match
   rsg::dds::Participant participant(options.domain, options.participant_profile, options.discovery,
                                     writers.listener());
-  rsg::tools::MonitorReaders readers(participant, options.topics());
+  rsg::app::MonitorReaders readers(participant, options.topics());
   StopOnSignal stop_on_signal([&readers] { readers.request_stop(); });
 
   const auto page_period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(1.0 / options.page_rate_hz));
   auto next_page = std::chrono::steady_clock::now();
-  rsg::tools::record::CdrSerializer serializer;
+  rsg::app::CdrSerializer serializer;
   rsg::tools::view::PageSummary summary;
   rsg::RobotState state;
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
   bool summary_pending = false;
-  rsg::tools::MatchedWriters matched_writers(options.topic, writers, options.domain);
+  rsg::app::MatchedWriters matched_writers(options.topic, writers, options.domain);
   while (!readers.stop_requested()) {
     readers.wait(kWakeUp);
     matched_writers.update(readers.state());
@@ -175,7 +175,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  rsg::tools::init_logging("rsg_view");
+  rsg::app::init_logging("rsg_view");
   StopOnSignal::block_stop_signals();  // before Fast DDS starts threads (stop_on_signal.hpp)
   CLI::App app{"Serves RobotState and GatewayStatus to Foxglove, PlotJuggler and a live web page.",
                "rsg_view"};

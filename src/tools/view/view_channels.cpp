@@ -12,7 +12,7 @@ namespace rsg::tools::view {
 namespace {
 
 using nlohmann::json;
-namespace schemas = rsg::tools::record::schemas;
+namespace schemas = rsg::app::schemas;
 
 // JSON Schemas of the JSON channels: Foxglove wants one per channel; these say the shape.
 constexpr std::string_view kFrameTransformSchema = R"({"type":"object","properties":{

@@ -84,13 +84,13 @@ std::string tables() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  rsg::tools::init_logging("rsg_wireshark_lua");
+  rsg::app::init_logging("rsg_wireshark_lua");
   CLI::App app{"Writes the Wireshark dissector from its template and the field table.", "rsg_wireshark_lua"};
   std::string template_path;
   std::string output_path;
   app.add_option("TEMPLATE", template_path, "The dissector's template (rsg_sendbuf.lua.in)")->required();
   app.add_option("OUTPUT", output_path, "The dissector to write")->required();
-  return rsg::tools::run_main(app, argc, argv, [&] {
+  return rsg::app::run_main(app, argc, argv, [&] {
     std::ifstream in(template_path, std::ios::binary);
     if (!in) throw rsg::InputError("cannot read '" + template_path + "'");
     std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -101,6 +101,6 @@ int main(int argc, char** argv) {
     std::ofstream out(output_path, std::ios::binary | std::ios::trunc);
     out << text;
     if (!out.flush()) throw rsg::EnvironmentError("cannot write '" + output_path + "'");
-    return rsg::tools::kExitOk;
+    return rsg::app::kExitOk;
   });
 }
