@@ -60,7 +60,8 @@ class Ingress {
     std::function<void(const RobotState&)> on_sample;
   };
 
-  /// Binds the socket and creates the writer. Throws std::runtime_error / std::system_error.
+  /// Binds the socket and creates the writers.
+  /// @throws rsg::EnvironmentError when the kernel refuses the socket or Fast DDS a writer.
   Ingress(dds::Participant& participant, Options options);
   ~Ingress();
   Ingress(const Ingress&) = delete;
@@ -96,7 +97,8 @@ class Ingress {
   transport::Endpoint local_endpoint() const { return socket_.local_endpoint(); }
 
   /// Writes the flight recorder's datagrams as a pcap file; nothing when it is off. Allocates and
-  /// writes a file: call it on a request or a link change, not per frame. Throws std::runtime_error.
+  /// writes a file: call it on a request or a link change, not per frame.
+  /// @throws rsg::EnvironmentError when the file cannot be written.
   std::optional<FlightRecorder::Dump> dump_flight_recorder(std::string_view reason);
   bool has_flight_recorder() const { return recorder_.has_value(); }
 

@@ -14,7 +14,7 @@ namespace rsg::gateway {
 
 class StatusPublisher {
  public:
-  /// Throws std::runtime_error when the writer cannot be created.
+  /// @throws rsg::EnvironmentError when Fast DDS refuses the writer.
   /// `type_name` "" keeps the IDL's name (rsg::GatewayStatus), else e.g. rsg::dds::kRos2GatewayStatusType.
   StatusPublisher(dds::Participant& participant, const std::string& topic,
                   const std::vector<std::string>& partitions, const std::string& profile,

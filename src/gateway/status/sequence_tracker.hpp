@@ -28,8 +28,8 @@
 // invalid datagram that fills no gap by then was not one of the robot's frames). A valid frame
 // that arrives late into such a gap is reordered, and the invalid one is taken to have held another
 // position of it (the simulator holds a frame back behind a corrupted one, and the gap shows only
-// at the next valid frame). "Lost" therefore means "never arrived at all" (dropped by the network or the sender), as
-// far as the packet numbers can tell.
+// at the next valid frame). "Lost" therefore means "never arrived at all" (dropped by the network or the
+// sender), as far as the packet numbers can tell.
 #pragma once
 
 #include <cstdint>
