@@ -128,6 +128,17 @@ const std::array kKeys = {
               }},
     ConfigKey{"stats-file", "Keep the counters as JSON in this file (rewritten every second and at exit)",
               &GatewayConfig::stats_file, [](const GatewayConfig&) { return std::string(); }},
+    ConfigKey{"metrics",
+              "Serve Prometheus metrics on http://HOST:PORT/metrics and a health check on /healthz "
+              "(200 while valid frames arrive in time, else 503)",
+              &GatewayConfig::metrics,
+              [](const GatewayConfig& c) {
+                return c.metrics.empty()
+                           ? ""
+                           : check_host_port(c.metrics, transport::HostPortRule::kPortMayBeZero);
+              }},
+    ConfigKey{"name", "This gateway's name: the `gateway` label of its metrics (default: the partition)",
+              &GatewayConfig::name, [](const GatewayConfig&) { return std::string(); }},
     ConfigKey{"pcap-ring",
               "Flight recorder: keep the last SECONDS of raw datagrams in memory and write them as a pcap "
               "file into --pcap-dir on SIGUSR1 and when the link goes down; 0: off",

@@ -49,6 +49,10 @@ struct GatewayConfig {
   std::string stats_file;
   std::string log_level = "info";
 
+  // Monitoring: Prometheus metrics and /healthz on HOST:PORT (metrics_server.hpp); "" : off
+  std::string metrics;
+  std::string name;  ///< the `gateway` label of the metrics; "" : the partition
+
   // Flight recorder: the last pcap_ring seconds of raw datagrams, dumped into pcap_dir as pcap
   double pcap_ring = 0;  ///< seconds; 0: off
   std::string pcap_dir;

@@ -19,6 +19,7 @@
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/ros2.hpp"
 #include "rsg/error.hpp"
+#include "version.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;
@@ -37,6 +38,10 @@ transport::Endpoint resolve(const std::string& flag, const std::string& host_por
   } catch (const InputError& error) {
     throw InputError("--" + flag + ": " + error.what());
   }
+}
+
+double unix_now_s() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
 // errno as "No such file or directory (ENOENT)".
@@ -180,7 +185,7 @@ GatewaySetup prepare(const GatewayConfig& config) {
 
   check_output_files(config);
 
-  GatewaySetup setup{config, std::nullopt, std::nullopt};
+  GatewaySetup setup{config, std::nullopt, std::nullopt, std::nullopt};
   if (config.has_ingress()) {
     Ingress::Options ingress;
     ingress.listen = resolve("listen", config.listen);
@@ -220,6 +225,7 @@ GatewaySetup prepare(const GatewayConfig& config) {
       egress.destinations.push_back(resolve("send-to", destination));
     setup.egress = std::move(egress);
   }
+  if (!config.metrics.empty()) setup.metrics = resolve("metrics", config.metrics);
   load_and_check_profiles(config);
   return setup;
 }
@@ -245,6 +251,11 @@ Gateway::Gateway(const GatewaySetup& setup)
     egress_.emplace(participant_, *setup.egress);
     spdlog::info("egress: topic '{}' -> UDP {}", setup.egress->topic, fmt::join(config_.send_to, ", "));
   }
+  link_last_change_s_ = unix_now_s();
+  if (setup.metrics) {
+    metrics_.emplace(MetricsServer::Options{*setup.metrics}, metrics_snapshot(snapshot(), Clock::now()));
+    spdlog::info("metrics: /metrics and /healthz on {} (TCP port {})", config_.metrics, metrics_->port());
+  }
 }
 
 void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump) {
@@ -254,7 +265,9 @@ void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump) {
     no_link_.emplace(ingress_->local_endpoint().to_string(), start);
   }
   rate_.update(0, start);
-  status_.publish(snapshot());
+  const GatewayStats first = snapshot();
+  status_.publish(first);
+  if (metrics_) metrics_->publish(metrics_snapshot(first, start));
   auto next_status = start + kStatusPeriod;
   next_summary_ = start + kSummaryPeriod;
 
@@ -287,6 +300,8 @@ void Gateway::on_link_change() {
   const GatewayStats stats = snapshot();
   spdlog::info("link {} ({})", stats.link_up ? "up" : "down", stats.source);
   status_.publish(stats);  // now, not at the next period: readers act on link changes
+  link_last_change_s_ = unix_now_s();
+  if (metrics_) metrics_->publish(metrics_snapshot(stats, Clock::now()));
   if (!stats.link_up) dump_flight_recorder("link_down");
 }
 
@@ -312,6 +327,7 @@ void Gateway::on_status_period(Clock::time_point now) {
   if (ingress_) ingress_->end_status_period();
   status_.publish(stats);
   write_stats_file(stats);
+  if (metrics_) metrics_->publish(metrics_snapshot(stats, now));
   if (no_link_)
     if (const auto warning = no_link_->due(stats, now)) spdlog::warn("{}", *warning);
   if (now >= next_summary_) {
@@ -329,6 +345,19 @@ GatewayStats Gateway::snapshot() const {
   }
   stats.rate_hz = stats.link_up ? rate_hz_ : 0.0;
   return stats;
+}
+
+MetricsSnapshot Gateway::metrics_snapshot(const GatewayStats& stats, Clock::time_point now) const {
+  MetricsSnapshot metrics;
+  metrics.stats = stats;
+  metrics.has_ingress = ingress_.has_value();
+  metrics.link_last_change_s = link_last_change_s_;
+  metrics.gateway = config_.name.empty() ? config_.partition : config_.name;
+  metrics.partition = config_.partition;
+  metrics.version = rsg_version();
+  metrics.fastdds_version = fastdds_version();
+  metrics.taken = now;
+  return metrics;
 }
 
 void enter_realtime_mode(const GatewayConfig& config) {

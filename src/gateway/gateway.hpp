@@ -12,6 +12,7 @@
 #include "egress.hpp"
 #include "ingress.hpp"
 #include "link_monitor.hpp"
+#include "metrics_server.hpp"
 #include "no_link_warning.hpp"
 #include "status_publisher.hpp"
 
@@ -22,6 +23,7 @@ struct GatewaySetup {
   GatewayConfig config;
   std::optional<Ingress::Options> ingress;
   std::optional<Egress::Options> egress;
+  std::optional<transport::Endpoint> metrics;  ///< where /metrics is served
 };
 
 /// Resolves and checks everything that can be checked without creating entities.
@@ -50,6 +52,7 @@ class Gateway {
   void on_status_period(Clock::time_point now);
   GatewayStats snapshot() const;
   void write_stats_file(const GatewayStats& stats);
+  MetricsSnapshot metrics_snapshot(const GatewayStats& stats, Clock::time_point now) const;
 
   GatewayConfig config_;
   dds::Participant participant_;  // first: outlives every entity below
@@ -61,6 +64,8 @@ class Gateway {
   Clock::time_point next_summary_{};
   std::optional<NoLinkWarning> no_link_;  // with ingress
   int stats_file_errno_ = 0;              // of the last failed write of the stats file; 0: it worked
+  double link_last_change_s_ = 0;         // Unix time, for the metrics
+  std::optional<MetricsServer> metrics_;  // last: serves snapshots of everything above
 };
 
 /// Puts the calling thread (the one that will call `Gateway::run`) in the configured real-time

@@ -1,0 +1,58 @@
+// The gateway's counters in Prometheus' text exposition format (version 0.0.4), served on
+// `--metrics HOST:PORT` by metrics_server.hpp, and the health verdict of its `/healthz`.
+//
+// The ingress thread takes a MetricsSnapshot once per status period and on every link change;
+// the server's thread formats it when a scraper asks. Nothing here runs per frame.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "clock.hpp"
+#include "stats.hpp"
+
+namespace rsg::gateway {
+
+/// What one scrape reports: the gateway's counters as of the last status period or link change.
+struct MetricsSnapshot {
+  GatewayStats stats;
+  bool has_ingress = false;
+  /// Unix time (s) of the last link change; the gateway's start before the first.
+  double link_last_change_s = 0;
+  /// The labels every series carries; an empty value leaves its label out.
+  std::string gateway;
+  std::string partition;
+  std::string version;          ///< rsg's (the CMake project version)
+  std::string fastdds_version;  ///< the Fast DDS rsg was built with
+  Clock::time_point taken{};    ///< when the ingress thread took it
+};
+
+/// The process's own figures, read when a scraper asks (not by the ingress thread).
+struct ProcessFigures {
+  double cpu_seconds = 0;     ///< user + system
+  double resident_bytes = 0;  ///< resident set size
+  double start_time_s = 0;    ///< Unix time the process started
+  double open_fds = 0;
+};
+
+/// The calling process's figures from getrusage and /proc/self; nothing when /proc cannot be read.
+std::optional<ProcessFigures> read_process_figures();
+
+/// The exposition text: # HELP and # TYPE of every family, then its samples. Counters end in
+/// `_total`, durations are in seconds, every series carries the snapshot's labels.
+std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<ProcessFigures>& process);
+
+/// The names of every metric family `format_metrics` writes (for the dashboard check).
+std::vector<std::string> metric_family_names();
+
+/// True while the snapshot says valid frames arrive within the link deadline and it is no older
+/// than `max_age` (a snapshot that stops coming means the loop that takes it is stuck). A gateway
+/// without ingress is healthy while its snapshots come.
+bool is_healthy(const MetricsSnapshot& snapshot, Clock::time_point now, Clock::duration max_age);
+
+/// A label value escaped for the exposition format (backslash, double quote, line feed).
+std::string escape_label_value(std::string_view value);
+
+}  // namespace rsg::gateway

@@ -1,0 +1,50 @@
+// `--metrics HOST:PORT`: an HTTP endpoint (Boost.Beast, one I/O thread of its own) that answers
+//   GET /metrics  the last MetricsSnapshot in Prometheus' text format (metrics.hpp)
+//   GET /healthz  200 while valid frames arrive within the link deadline, else 503
+// and 404 to any other path, 405 to any other method.
+//
+// The ingress thread never waits for the HTTP side: `publish` swaps in a new snapshot (an atomic
+// shared pointer) and returns; the I/O thread formats it when a scraper asks. Bad clients cost the
+// I/O thread only: request headers are capped (kMaxRequestHeader), a request must arrive whole
+// within kRequestTimeout, and at most Options::max_connections connections are open at once
+// (more are closed as soon as they are accepted).
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+
+#include "metrics.hpp"
+#include "rsg/transport/udp_socket.hpp"
+
+namespace rsg::gateway {
+
+class MetricsServer {
+ public:
+  struct Options {
+    transport::Endpoint listen;  ///< port 0: any free port (see port())
+    std::size_t max_connections = 32;
+    /// A snapshot older than this makes /healthz answer 503: the loop that takes them is stuck.
+    Clock::duration max_snapshot_age = std::chrono::seconds(3);
+  };
+
+  static constexpr std::size_t kMaxRequestHeader = 8 * 1024;
+  static constexpr auto kRequestTimeout = std::chrono::seconds(5);
+
+  /// Binds and starts serving. Throws rsg::EnvironmentError when the address cannot be bound.
+  MetricsServer(const Options& options, MetricsSnapshot first);
+  ~MetricsServer();
+  MetricsServer(const MetricsServer&) = delete;
+  MetricsServer& operator=(const MetricsServer&) = delete;
+
+  /// Makes `snapshot` what the next scrape reports. Any thread; never waits for a client.
+  void publish(MetricsSnapshot snapshot);
+
+  std::uint16_t port() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rsg::gateway

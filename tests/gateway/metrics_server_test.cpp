@@ -1,0 +1,167 @@
+// The metrics endpoint over a real loopback TCP connection: what each path answers, and what a
+// client that misbehaves gets. The gateway under such clients at 1 kHz: integration.metrics_abuse.
+#include "metrics_server.hpp"
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <string>
+
+#include "rsg/error.hpp"
+
+namespace rsg::gateway {
+namespace {
+
+using namespace std::chrono_literals;
+
+MetricsSnapshot snapshot(bool link_up) {
+  MetricsSnapshot s;
+  s.has_ingress = true;
+  s.gateway = "robot1";
+  s.stats.link_up = link_up;
+  s.stats.ingress.published = 5;
+  s.taken = Clock::now();
+  return s;
+}
+
+MetricsServer::Options loopback() {
+  MetricsServer::Options options;
+  options.listen = transport::Endpoint::parse("127.0.0.1:0");
+  options.max_connections = 4;
+  return options;
+}
+
+// A blocking client connection.
+class Client {
+ public:
+  explicit Client(std::uint16_t port) : fd_(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0)) {
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_port = htons(port);
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (::connect(fd_, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0)
+      throw std::runtime_error("cannot connect");
+  }
+  ~Client() { ::close(fd_); }
+  Client(const Client&) = delete;
+  Client& operator=(const Client&) = delete;
+
+  void send(const std::string& text) {
+    ASSERT_EQ(::send(fd_, text.data(), text.size(), MSG_NOSIGNAL), ssize_t(text.size()));
+  }
+
+  /// Everything until the server closes or `timeout` passes without a byte.
+  std::string read_all(std::chrono::milliseconds timeout = 3000ms) {
+    std::string text;
+    for (;;) {
+      pollfd waiting{fd_, POLLIN, 0};
+      if (::poll(&waiting, 1, static_cast<int>(timeout.count())) != 1) return text;
+      char buffer[4096];
+      const ssize_t size = ::recv(fd_, buffer, sizeof buffer, 0);
+      if (size <= 0) {
+        closed_ = true;
+        return text;
+      }
+      text.append(buffer, static_cast<std::size_t>(size));
+    }
+  }
+
+  /// Whether the server closed the connection during the last read_all.
+  bool closed() const { return closed_; }
+
+ private:
+  int fd_;
+  bool closed_ = false;
+};
+
+std::string get(std::uint16_t port, const std::string& target, const std::string& method = "GET") {
+  Client client(port);
+  client.send(method + " " + target + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+  return client.read_all();
+}
+
+TEST(MetricsServer, MetricsAnswersTheLastPublishedSnapshotInTheExpositionFormat) {
+  MetricsServer server(loopback(), snapshot(true));
+  auto response = get(server.port(), "/metrics");
+  EXPECT_TRUE(response.starts_with("HTTP/1.1 200 OK\r\n")) << response;
+  EXPECT_NE(response.find("Content-Type: text/plain; version=0.0.4; charset=utf-8\r\n"), std::string::npos);
+  EXPECT_NE(response.find("\nrsg_frames_published_total{gateway=\"robot1\"} 5\n"), std::string::npos);
+  EXPECT_NE(response.find("\nprocess_cpu_seconds_total{gateway=\"robot1\"} "), std::string::npos);
+
+  MetricsSnapshot later = snapshot(true);
+  later.stats.ingress.published = 6;
+  server.publish(later);
+  response = get(server.port(), "/metrics?x=1");
+  EXPECT_NE(response.find("\nrsg_frames_published_total{gateway=\"robot1\"} 6\n"), std::string::npos);
+}
+
+TEST(MetricsServer, HealthzFollowsTheLink) {
+  MetricsServer server(loopback(), snapshot(true));
+  EXPECT_TRUE(get(server.port(), "/healthz").starts_with("HTTP/1.1 200 OK\r\n"));
+  server.publish(snapshot(false));
+  const auto response = get(server.port(), "/healthz");
+  EXPECT_TRUE(response.starts_with("HTTP/1.1 503 Service Unavailable\r\n")) << response;
+  EXPECT_TRUE(response.ends_with("link down\n")) << response;
+}
+
+TEST(MetricsServer, OtherPathsAre404AndOtherMethods405) {
+  MetricsServer server(loopback(), snapshot(true));
+  EXPECT_TRUE(get(server.port(), "/").starts_with("HTTP/1.1 404 Not Found\r\n"));
+  EXPECT_TRUE(get(server.port(), "/metrics/x").starts_with("HTTP/1.1 404 Not Found\r\n"));
+  EXPECT_TRUE(get(server.port(), "/metrics", "POST").starts_with("HTTP/1.1 405 Method Not Allowed\r\n"));
+}
+
+TEST(MetricsServer, AHeaderOverTheLimitIsRefusedAndTheConnectionClosed) {
+  MetricsServer server(loopback(), snapshot(true));
+  Client client(server.port());
+  client.send("GET /metrics HTTP/1.1\r\nX-Big: " + std::string(MetricsServer::kMaxRequestHeader, 'a') +
+              "\r\n\r\n");
+  const auto response = client.read_all();
+  EXPECT_TRUE(response.starts_with("HTTP/1.1 431 ")) << response.substr(0, 100);
+}
+
+TEST(MetricsServer, ConnectionsOverTheCapAreClosedWhileTheOthersAreServed) {
+  MetricsServer server(loopback(), snapshot(true));
+  std::vector<std::unique_ptr<Client>> idle;
+  for (int i = 0; i < 4; ++i) idle.push_back(std::make_unique<Client>(server.port()));
+  // The cap is reached once the server has accepted them; a fifth is closed unanswered.
+  std::string refused;
+  for (int attempt = 0; attempt < 50 && refused.empty(); ++attempt) {
+    Client extra(server.port());
+    extra.send("GET /metrics HTTP/1.1\r\nHost: x\r\n\r\n");
+    if (extra.read_all(1000ms).empty() && extra.closed()) refused = "closed";
+  }
+  EXPECT_EQ(refused, "closed");
+  idle.clear();  // the server notices the closed ones and serves again
+  std::string served;
+  for (int attempt = 0; attempt < 50 && served.empty(); ++attempt) {
+    const auto response = get(server.port(), "/healthz");
+    if (response.starts_with("HTTP/1.1 200"))
+      served = response;
+    else
+      ::usleep(100000);
+  }
+  EXPECT_FALSE(served.empty());
+}
+
+TEST(MetricsServer, AClientThatNeverFinishesItsRequestIsClosedAfterTheTimeout) {
+  MetricsServer server(loopback(), snapshot(true));
+  Client slow(server.port());
+  slow.send("GET /metrics HTTP/1.1\r\n");  // and nothing more
+  EXPECT_EQ(slow.read_all(MetricsServer::kRequestTimeout + 5s), "");
+  EXPECT_TRUE(slow.closed()) << "the server still holds a request that never ends";
+}
+
+TEST(MetricsServer, APortThatIsTakenIsAnEnvironmentError) {
+  MetricsServer first(loopback(), snapshot(true));
+  MetricsServer::Options same = loopback();
+  same.listen = transport::Endpoint::parse("127.0.0.1:" + std::to_string(first.port()));
+  EXPECT_THROW(MetricsServer(same, snapshot(true)), EnvironmentError);
+}
+
+}  // namespace
+}  // namespace rsg::gateway

@@ -1,0 +1,162 @@
+// The Prometheus text exposition of the gateway's counters (src/gateway/metrics.hpp). That
+// Prometheus itself accepts it is shown by integration.metrics_prometheus (promtool and a real
+// server); here: what each line says.
+#include "metrics.hpp"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace rsg::gateway {
+namespace {
+
+MetricsSnapshot example() {
+  MetricsSnapshot snapshot;
+  snapshot.has_ingress = true;
+  snapshot.gateway = "robot1";
+  snapshot.partition = "cell \"A\"\\2";
+  snapshot.version = "0.1.0";
+  snapshot.fastdds_version = "2.9.1";
+  snapshot.link_last_change_s = 1764165600.5;
+  auto& stats = snapshot.stats;
+  stats.ingress.received = 1200;
+  stats.ingress.published = 1000;
+  stats.ingress.invalid[invalid_index(wire::ErrorCategory::kBadCrc)] = 150;
+  stats.ingress.invalid[invalid_index(wire::ErrorCategory::kTruncated)] = 50;
+  stats.ingress.rejected_source = 7;
+  stats.sequence.lost = 3;
+  stats.egress.frames_sent = 42;
+  stats.state_readers = 2;
+  stats.link_up = true;
+  stats.rate_hz = 999.5;
+  stats.ingress_delay_us = 250;
+  stats.ingress_delay_max_us = 1500;
+  return snapshot;
+}
+
+// Every sample line: "name{labels}" -> value.
+std::map<std::string, std::string> samples(const std::string& text) {
+  std::map<std::string, std::string> out;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    const auto space = line.rfind(' ');
+    out[line.substr(0, space)] = line.substr(space + 1);
+  }
+  return out;
+}
+
+constexpr std::string_view kLabels = R"(gateway="robot1",partition="cell \"A\"\\2")";
+
+std::string series(std::string_view name, std::string_view extra = {}) {
+  return std::string(name) + "{" + std::string(kLabels) + (extra.empty() ? "" : ",") + std::string(extra) +
+         "}";
+}
+
+TEST(Metrics, EachCounterOfTheSnapshotIsOneSampleWithTheGatewaysLabels) {
+  const auto text = format_metrics(example(), std::nullopt);
+  const auto values = samples(text);
+  EXPECT_EQ(values.at(series("rsg_frames_received_total")), "1200");
+  EXPECT_EQ(values.at(series("rsg_frames_published_total")), "1000");
+  EXPECT_EQ(values.at(series("rsg_frames_rejected_source_total")), "7");
+  EXPECT_EQ(values.at(series("rsg_frames_lost_total")), "3");
+  EXPECT_EQ(values.at(series("rsg_egress_frames_sent_total")), "42");
+  EXPECT_EQ(values.at(series("rsg_state_readers")), "2");
+  EXPECT_EQ(values.at(series("rsg_link_up")), "1");
+  EXPECT_EQ(values.at(series("rsg_frame_rate_hertz")), "999.5");
+  EXPECT_EQ(values.at(series("rsg_link_last_change_timestamp_seconds")), "1764165600.5");
+  EXPECT_EQ(values.at(series("rsg_ingress_delay_seconds")), "0.00025");
+  EXPECT_EQ(values.at(series("rsg_ingress_delay_max_seconds")), "0.0015");
+  EXPECT_EQ(values.at(series("rsg_build_info", R"(version="0.1.0",fastdds_version="2.9.1")")), "1");
+}
+
+TEST(Metrics, InvalidFramesHaveOneSeriesPerSpecCategoryZerosIncluded) {
+  const auto values = samples(format_metrics(example(), std::nullopt));
+  for (std::size_t i = 0; i < wire::kErrorCategoryCount; ++i) {
+    const auto category = category_at(i);
+    const std::string expected = category == wire::ErrorCategory::kBadCrc      ? "150"
+                                 : category == wire::ErrorCategory::kTruncated ? "50"
+                                                                               : "0";
+    EXPECT_EQ(values.at(series("rsg_frames_invalid_total",
+                               "category=\"" + std::string(wire::to_string(category)) + "\"")),
+              expected)
+        << wire::to_string(category);
+  }
+}
+
+TEST(Metrics, EveryFamilyHasHelpAndTypeBeforeItsSamplesAndCountersEndInTotal) {
+  ProcessFigures process{12.5, 4096.0 * 1000, 1764160000.0, 17};
+  const auto text = format_metrics(example(), process);
+  std::istringstream lines(text);
+  std::map<std::string, std::string> types;
+  std::set<std::string> helped, sampled;
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::string first, name, type;
+    words >> first;
+    if (first == "#") {
+      std::string keyword;
+      words >> keyword >> name;
+      if (keyword == "HELP") {
+        EXPECT_FALSE(sampled.contains(name)) << name << ": HELP after its samples";
+        helped.insert(name);
+      } else if (keyword == "TYPE") {
+        words >> type;
+        EXPECT_TRUE(types.emplace(name, type).second) << name << ": two TYPE lines";
+      }
+      continue;
+    }
+    name = first.substr(0, first.find('{'));
+    ASSERT_TRUE(types.contains(name)) << name << ": a sample before its TYPE";
+    sampled.insert(name);
+  }
+  const auto names = metric_family_names();
+  EXPECT_EQ(std::set<std::string>(names.begin(), names.end()), sampled);
+  for (const auto& [name, type] : types) {
+    EXPECT_TRUE(helped.contains(name)) << name;
+    EXPECT_EQ(type == "counter", name.ends_with("_total")) << name << " is a " << type;
+    EXPECT_TRUE(type == "counter" || type == "gauge") << name;
+  }
+  const auto values = samples(text);
+  EXPECT_EQ(values.at(series("process_cpu_seconds_total")), "12.5");
+  EXPECT_EQ(values.at(series("process_resident_memory_bytes")), "4096000");
+}
+
+TEST(Metrics, WithoutANameOrPartitionTheSeriesCarryNoGatewayLabels) {
+  MetricsSnapshot snapshot = example();
+  snapshot.gateway.clear();
+  snapshot.partition.clear();
+  const auto values = samples(format_metrics(snapshot, std::nullopt));
+  EXPECT_EQ(values.at("rsg_frames_published_total"), "1000");
+  EXPECT_EQ(values.at("rsg_frames_invalid_total{category=\"bad_crc\"}"), "150");
+}
+
+TEST(Metrics, LabelValuesEscapeBackslashQuoteAndLineFeed) {
+  EXPECT_EQ(escape_label_value("a\\b\"c\nd"), "a\\\\b\\\"c\\nd");
+}
+
+TEST(Metrics, TheProcessFiguresOfThisProcessAreRead) {
+  const auto process = read_process_figures();
+  ASSERT_TRUE(process.has_value());
+  EXPECT_GT(process->resident_bytes, 0);
+  EXPECT_GT(process->start_time_s, 1.6e9);  // after 2020
+  EXPECT_GE(process->open_fds, 3);          // stdin, stdout, stderr
+}
+
+TEST(Metrics, HealthyWhileTheLinkIsUpAndTheSnapshotIsFresh) {
+  MetricsSnapshot snapshot = example();
+  const auto now = Clock::now();
+  snapshot.taken = now;
+  const auto max_age = std::chrono::seconds(3);
+  EXPECT_TRUE(is_healthy(snapshot, now + std::chrono::seconds(1), max_age));
+  EXPECT_FALSE(is_healthy(snapshot, now + std::chrono::seconds(4), max_age)) << "a stale snapshot";
+  snapshot.stats.link_up = false;
+  EXPECT_FALSE(is_healthy(snapshot, now, max_age)) << "link down";
+  snapshot.has_ingress = false;
+  EXPECT_TRUE(is_healthy(snapshot, now, max_age)) << "egress only: no link to watch";
+}
+
+}  // namespace
+}  // namespace rsg::gateway
