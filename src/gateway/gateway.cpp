@@ -258,7 +258,7 @@ Gateway::Gateway(const GatewaySetup& setup)
   }
 }
 
-void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump) {
+void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump, LoopObserver* observer) {
   const auto start = Clock::now();
   if (ingress_) {
     ingress_->start(start);
@@ -267,7 +267,9 @@ void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump) {
   rate_.update(0, start);
   const GatewayStats first = snapshot();
   status_.publish(first);
+  write_stats_file(first);  // before READY: a stats file exists once the gateway is up
   if (metrics_) metrics_->publish(metrics_snapshot(first, start));
+  if (observer != nullptr) observer->started(first, ingress_.has_value());
   auto next_status = start + kStatusPeriod;
   next_summary_ = start + kSummaryPeriod;
 
@@ -285,11 +287,14 @@ void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump) {
     if (ingress_ && ingress_->link_changed(now)) on_link_change();
     if (dump != nullptr && dump->exchange(false)) dump_flight_recorder("signal");
     if (now >= next_status) {
-      on_status_period(now);
+      const GatewayStats stats = on_status_period(now);
+      if (observer != nullptr) observer->status(stats, ingress_.has_value());
       next_status = std::max(next_status + kStatusPeriod, now);  // after a stall, do not catch up
     }
+    if (observer != nullptr) observer->turned(now);  // the watchdog: only while this loop turns
   }
 
+  if (observer != nullptr) observer->stopping();
   const GatewayStats final_stats = snapshot();
   status_.publish(final_stats);
   write_stats_file(final_stats);
@@ -318,7 +323,7 @@ void Gateway::dump_flight_recorder(std::string_view reason) {
   }
 }
 
-void Gateway::on_status_period(Clock::time_point now) {
+GatewayStats Gateway::on_status_period(Clock::time_point now) {
   if (ingress_) {
     rate_hz_ = rate_.update(ingress_->valid_frames(), now);
     ingress_->log_rejections();
@@ -334,6 +339,7 @@ void Gateway::on_status_period(Clock::time_point now) {
     next_summary_ = now + kSummaryPeriod;
     spdlog::info("{}", summary_line(stats));
   }
+  return stats;
 }
 
 GatewayStats Gateway::snapshot() const {

@@ -12,6 +12,7 @@
 #include "egress.hpp"
 #include "ingress.hpp"
 #include "link_monitor.hpp"
+#include "loop_observer.hpp"
 #include "metrics_server.hpp"
 #include "no_link_warning.hpp"
 #include "status_publisher.hpp"
@@ -37,9 +38,12 @@ class Gateway {
   /// rsg::InputError for a view or profile that turns out unusable.
   explicit Gateway(const GatewaySetup& setup);
 
-  /// Receives, publishes and reports until `stop` is set, then writes the final status. Whenever
-  /// `dump` (when given) is set, it clears it and writes the flight recorder's pcap file.
-  void run(const std::atomic<bool>& stop, std::atomic<bool>* dump = nullptr);
+  /// Writes the first status and stats file, then receives, publishes and reports until `stop` is
+  /// set, then writes the final status. Whenever `dump` (when given) is set, it clears it and
+  /// writes the flight recorder's pcap file. `observer` (when given) hears of the start, every
+  /// turn of the loop and every status period, on this thread.
+  void run(const std::atomic<bool>& stop, std::atomic<bool>* dump = nullptr,
+           LoopObserver* observer = nullptr);
 
   /// Where ingress receives frames; nothing when there is no ingress.
   std::optional<transport::Endpoint> ingress_endpoint() const {
@@ -49,7 +53,7 @@ class Gateway {
  private:
   void on_link_change();
   void dump_flight_recorder(std::string_view reason);
-  void on_status_period(Clock::time_point now);
+  GatewayStats on_status_period(Clock::time_point now);  // returns the stats it reported
   GatewayStats snapshot() const;
   void write_stats_file(const GatewayStats& stats);
   MetricsSnapshot metrics_snapshot(const GatewayStats& stats, Clock::time_point now) const;

@@ -15,6 +15,7 @@
 #include "config.hpp"
 #include "gateway.hpp"
 #include "rsg/error.hpp"
+#include "service_notifier.hpp"
 #include "stop_on_signal.hpp"
 #include "tool_main.hpp"
 
@@ -104,7 +105,8 @@ int main(int argc, char** argv) {
     rsg::gateway::Gateway gateway(setup);
     rsg::app::log_with_timestamps();  // started: from here on a log of a running service
     rsg::gateway::enter_realtime_mode(config);
-    gateway.run(stop, &dump);
+    rsg::gateway::ServiceNotifier systemd;  // READY, STATUS and the watchdog under a Type=notify unit
+    gateway.run(stop, &dump, &systemd);
     return kExitOk;
   });
 }

@@ -67,6 +67,16 @@ def free_udp_port():
         return probe.getsockname()[1]
 
 
+def port_is_free(port):
+    """Whether UDP `port` on 127.0.0.1 can be bound right now (no one holds it)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        try:
+            probe.bind(("127.0.0.1", port))
+            return True
+        except OSError:
+            return False
+
+
 def test_domain():
     """A DDS domain of this test alone (ctest runs tests as separate processes)."""
     return os.getpid() % 200 + 10

@@ -10,16 +10,7 @@ import sys
 import time
 from pathlib import Path
 
-from harness import check, main, read_json, wait_for, wait_for_stats, free_udp_port
-
-
-def port_is_free(port):
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        try:
-            probe.bind(("127.0.0.1", port))
-            return True
-        except OSError:
-            return False
+from harness import check, main, read_json, wait_for, wait_for_stats, free_udp_port, port_is_free
 
 
 def expect_refusal(h, label, flags, words):
