@@ -4,6 +4,7 @@
 // configuration (flags, file, profiles, addresses) is unusable, 1 when the machine refuses (the port
 // is taken, DDS refuses an entity); nothing is left running then. A refused real-time setting
 // (--rt-priority, --cpu) is a warning, not a failure.
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -18,6 +19,7 @@
 #include "service_notifier.hpp"
 #include "stop_on_signal.hpp"
 #include "tool_main.hpp"
+#include "version.hpp"
 
 namespace {
 
@@ -90,6 +92,10 @@ int main(int argc, char** argv) {
   StopOnSignal::block_stop_signals(/*with_dump=*/true);
   CLI::App app("rsg_gateway: robot-state frames over UDP <-> RobotState DDS samples", "rsg_gateway");
   app.footer(kRealtimeHelp);
+  app.set_version_flag("--version",
+                       fmt::format("rsg_gateway {} (Fast DDS {})", rsg::gateway::rsg_version(),
+                                   rsg::gateway::fastdds_version()),
+                       "Print rsg's version and the Fast DDS version it was built with, and exit");
   GatewayConfig flags_only;
   std::string config_file;
   add_config_flags(app, flags_only, config_file);
