@@ -15,6 +15,7 @@
 
 #include "config.hpp"
 #include "gateway.hpp"
+#include "journal_log.hpp"
 #include "rsg/error.hpp"
 #include "service_notifier.hpp"
 #include "stop_on_signal.hpp"
@@ -89,6 +90,7 @@ GatewayConfig read_config(const std::string& config_file, const GatewayConfig& f
 
 int main(int argc, char** argv) {
   rsg::app::init_logging("rsg_gateway");
+  rsg::gateway::use_journal_priorities();  // under systemd: each line's level as its journal priority
   StopOnSignal::block_stop_signals(/*with_dump=*/true);
   CLI::App app("rsg_gateway: robot-state frames over UDP <-> RobotState DDS samples", "rsg_gateway");
   app.footer(kRealtimeHelp);
