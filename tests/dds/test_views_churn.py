@@ -152,7 +152,10 @@ def body(h):
           f"gateway ingress delay max {during['ingress_delay_max_us']} us; robot's longest silence {silent_us} us; "
           f"link-down reports {link_downs}", flush=True)
 
-    # The readers that stay: exactly their frames, in order.
+    # The readers that stay: exactly their frames, in order. First every churned reader must be
+    # gone from the writer's count (the SIGKILLed ones by lease expiry), or the count below could be
+    # met by stale readers before the writer matched the new ones, and they would miss the start.
+    wait_for_stats(stats, lambda s: s["state_readers"] == 0, "the churned readers to leave the writer", timeout_s=90)
     finals = {"final_view": (["--view", "view_forces"], 0b001100), "final_groups": (["--groups", "3,5"], 0b101000)}
     for label, (args, _) in finals.items():
         h.start(label, [echo, *domain, "--ros2", *args, "--json", "--timeout", "5"])
