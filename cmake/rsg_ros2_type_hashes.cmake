@@ -1,88 +1,24 @@
-# RIHS01 type hashes of the ROS 2 types rsg_gateway publishes (rsg_msgs' RobotState and GatewayStatus,
-# sensor_msgs/JointState, tf2_msgs/TFMessage, geometry_msgs/WrenchStamped), computed at build time by
-# rosidl's type-description generator (ros2/type_hashes.py in the ROS 2 environment of `make deps`)
-# into ${CMAKE_BINARY_DIR}/generated/rsg_ros2_type_hashes.hpp, for the gateway to announce as
-# typehash=RIHS01_...; in its writers' USER_DATA, as rmw_fastrtps does. Without that environment (a
-# build with only the build packages, e.g. the container image) the header lists no hash and the
-# gateway announces none: ROS 2 nodes still read it, `ros2 topic info -v` then shows the hash INVALID.
-# A build tree without the environment can take the header another tree generated from the same
-# .msg files instead (RSG_ROS2_TYPE_HASHES_FROM: the Fast DDS 3 build in the chroot of
-# tests/fastdds3/run.sh takes the host build's); the hashes depend on the .msg files only.
-set(RSG_DEPS_DIR ${PROJECT_SOURCE_DIR}/.deps CACHE PATH "Where make deps puts the project's tools (DEPS_DIR)")
-set(RSG_ROS2_TYPE_HASHES_FROM "" CACHE FILEPATH
-    "Without the ROS 2 environment: the rsg_ros2_type_hashes.hpp another build tree generated, to copy")
+# RIHS01 type hashes (REP 2011) of the ROS 2 types rsg_gateway publishes (rsg_msgs' RobotState and
+# GatewayStatus, sensor_msgs/JointState, tf2_msgs/TFMessage, geometry_msgs/WrenchStamped), for the
+# gateway to announce as typehash=RIHS01_...; in its writers' USER_DATA, as rmw_fastrtps does.
+# Computed at build time from the .msg files by ros2/type_hashes.py (Python's standard library only,
+# no ROS 2 installation) into ${CMAKE_BINARY_DIR}/generated/rsg_ros2_type_hashes.hpp: every build
+# announces them, the image, a package and the Fast DDS 3 build included. rsg_msgs' members come
+# from ros2/rsg_msgs/msg, the standard types' (fixed by ROS 2) from ros2/standard_msgs. rosidl is
+# the judge: ros2.type_hashes_match_rosidl compares the header with rosidl's hashes.
+find_package(Python3 REQUIRED COMPONENTS Interpreter)
 set(RSG_ROS2_TYPE_HASHES_HPP ${CMAKE_BINARY_DIR}/generated/rsg_ros2_type_hashes.hpp)
-set(_rsg_ros2_venv ${RSG_DEPS_DIR}/ros2)
-set(_rsg_ros2_install ${RSG_DEPS_DIR}/ros2_ws/install)
-set(_rsg_ros2_standard sensor_msgs/msg/JointState tf2_msgs/msg/TFMessage geometry_msgs/msg/WrenchStamped)
-set(_rsg_ros2_standard_json ${_rsg_ros2_venv}/share/sensor_msgs/msg/JointState.json
-    ${_rsg_ros2_install}/share/tf2_msgs/msg/TFMessage.json ${_rsg_ros2_venv}/share/geometry_msgs/msg/WrenchStamped.json)
-set(_rsg_ros2_ok FALSE)
-if(EXISTS ${_rsg_ros2_venv}/bin/python)
-  execute_process(COMMAND ${CMAKE_COMMAND} -E env _ROS_WHEELS_BOOTSTRAP_COMPLETE=1 ${_rsg_ros2_venv}/bin/python -c
-                          "import rosidl_adapter.msg, rosidl_generator_type_description"
-                  RESULT_VARIABLE _rsg_ros2_import OUTPUT_QUIET ERROR_QUIET)
-  set(_rsg_ros2_ok TRUE)
-  if(_rsg_ros2_import)
-    set(_rsg_ros2_ok FALSE)
-  endif()
-  foreach(json ${_rsg_ros2_standard_json})
-    if(NOT EXISTS ${json})
-      set(_rsg_ros2_ok FALSE)
-    endif()
-  endforeach()
-endif()
-
+set(_rsg_ros2_types rsg_msgs/msg/RobotState rsg_msgs/msg/GatewayStatus sensor_msgs/msg/JointState
+    tf2_msgs/msg/TFMessage geometry_msgs/msg/WrenchStamped)
+file(GLOB_RECURSE _rsg_ros2_msgs CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/ros2/rsg_msgs/msg/*.msg
+     ${PROJECT_SOURCE_DIR}/ros2/standard_msgs/*.msg)
 file(MAKE_DIRECTORY ${CMAKE_BINARY_DIR}/generated)
-if(_rsg_ros2_ok)
-  if(EXISTS ${RSG_ROS2_TYPE_HASHES_HPP})  # left by a configuration without the environment: newer
-    file(STRINGS ${RSG_ROS2_TYPE_HASHES_HPP} _rsg_ros2_unknown  # than any input
-         REGEX "kTypeHashesKnown = false|^// Copied by CMake")
-    if(_rsg_ros2_unknown)
-      file(REMOVE ${RSG_ROS2_TYPE_HASHES_HPP})
-    endif()
-  endif()
-  file(GLOB _rsg_ros2_msgs CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/ros2/rsg_msgs/msg/*.msg)
-  add_custom_command(
-    OUTPUT ${RSG_ROS2_TYPE_HASHES_HPP}
-    COMMAND ${CMAKE_COMMAND} -E env _ROS_WHEELS_BOOTSTRAP_COMPLETE=1
-            "AMENT_PREFIX_PATH=${_rsg_ros2_install}:${_rsg_ros2_venv}"
-            ${_rsg_ros2_venv}/bin/python ${PROJECT_SOURCE_DIR}/ros2/type_hashes.py ${RSG_ROS2_TYPE_HASHES_HPP}
-            ${CMAKE_BINARY_DIR}/ros2_type_hashes ${PROJECT_SOURCE_DIR}/ros2/rsg_msgs
-            --standard ${_rsg_ros2_standard} > /dev/null
-    DEPENDS ${PROJECT_SOURCE_DIR}/ros2/type_hashes.py ${_rsg_ros2_msgs} ${_rsg_ros2_standard_json}
-    COMMENT "rosidl: RIHS01 type hashes of rsg_msgs and the standard ROS 2 types")
-  message(STATUS "ROS 2 type hashes: computed by rosidl from ${_rsg_ros2_venv}")
-elseif(RSG_ROS2_TYPE_HASHES_FROM)
-  if(NOT EXISTS ${RSG_ROS2_TYPE_HASHES_FROM})
-    message(FATAL_ERROR "RSG_ROS2_TYPE_HASHES_FROM: no file ${RSG_ROS2_TYPE_HASHES_FROM}")
-  endif()
-  file(READ ${RSG_ROS2_TYPE_HASHES_FROM} _rsg_ros2_copied)
-  if(NOT _rsg_ros2_copied MATCHES "kTypeHashesKnown = true")
-    message(FATAL_ERROR "RSG_ROS2_TYPE_HASHES_FROM: ${RSG_ROS2_TYPE_HASHES_FROM} lists no type hash")
-  endif()
-  file(CONFIGURE OUTPUT ${RSG_ROS2_TYPE_HASHES_HPP}
-       CONTENT "// Copied by CMake from ${RSG_ROS2_TYPE_HASHES_FROM} (RSG_ROS2_TYPE_HASHES_FROM).\n${_rsg_ros2_copied}" @ONLY)
-  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${RSG_ROS2_TYPE_HASHES_FROM})
-  message(STATUS "ROS 2 type hashes: copied from ${RSG_ROS2_TYPE_HASHES_FROM}")
-else()
-  set(_rsg_ros2_empty "// Generated by CMake: no ROS 2 environment in ${RSG_DEPS_DIR} (make deps), so no type hash.
-#pragma once
-
-#include <array>
-#include <string_view>
-#include <utility>
-
-namespace rsg::ros2_generated {
-
-inline constexpr bool kTypeHashesKnown = false;
-inline constexpr std::array<std::pair<std::string_view, std::string_view>, 0> kTypeHashes{};
-
-}  // namespace rsg::ros2_generated
-")
-  file(CONFIGURE OUTPUT ${RSG_ROS2_TYPE_HASHES_HPP} CONTENT "${_rsg_ros2_empty}")
-  message(STATUS "ROS 2 type hashes: none (no ROS 2 environment in ${RSG_DEPS_DIR}: make deps, then re-run cmake)")
-endif()
+add_custom_command(
+  OUTPUT ${RSG_ROS2_TYPE_HASHES_HPP}
+  COMMAND Python3::Interpreter ${PROJECT_SOURCE_DIR}/ros2/type_hashes.py --header ${RSG_ROS2_TYPE_HASHES_HPP}
+          --types ${_rsg_ros2_types} -- ${PROJECT_SOURCE_DIR}/ros2/rsg_msgs ${PROJECT_SOURCE_DIR}/ros2/standard_msgs
+  DEPENDS ${PROJECT_SOURCE_DIR}/ros2/type_hashes.py ${_rsg_ros2_msgs}
+  COMMENT "RIHS01 type hashes of rsg_msgs and the standard ROS 2 types (REP 2011)")
 add_custom_target(rsg_ros2_type_hashes_header DEPENDS ${RSG_ROS2_TYPE_HASHES_HPP})
 add_library(rsg_ros2_type_hashes INTERFACE)
 target_include_directories(rsg_ros2_type_hashes SYSTEM INTERFACE $<BUILD_INTERFACE:${CMAKE_BINARY_DIR}/generated>)

@@ -1,8 +1,7 @@
 // The RIHS01 type hash a ROS 2 node expects in the USER_DATA of rsg's writers and readers of ROS 2
 // types: "typehash=RIHS01_<64 hex>;", as rmw_fastrtps (rmw_dds_common) writes it and reads it for
-// `ros2 topic info -v` and type checks. The hashes come from rosidl at build time
-// (cmake/rsg_ros2_type_hashes.cmake); without the ROS 2 environment the list is empty and nothing is
-// announced.
+// `ros2 topic info -v` and type checks. Every build computes the hashes from the .msg files
+// (cmake/rsg_ros2_type_hashes.cmake, REP 2011), with or without ROS 2; rosidl judges them in a test.
 #pragma once
 
 #include <fastdds/dds/core/policy/QosPolicies.hpp>
@@ -21,8 +20,8 @@
 
 namespace rsg::gateway {
 
-/// The hash rosidl computed for a ROS 2 type, by its DDS name ("rsg_msgs::msg::dds_::RobotState_") or
-/// its ROS name ("rsg_msgs/msg/RobotState"); "" when unknown (not a ROS 2 type, or no hashes built).
+/// The RIHS01 hash of a ROS 2 type, by its DDS name ("rsg_msgs::msg::dds_::RobotState_") or
+/// its ROS name ("rsg_msgs/msg/RobotState"); "" when it is not one of the ROS 2 types the gateway uses.
 inline std::string_view ros2_type_hash(std::string_view type_name) {
   constexpr std::string_view kDdsInfix = "::msg::dds_::";  // pkg::msg::dds_::Type_ is pkg/msg/Type
   std::string ros_name(type_name);

@@ -77,8 +77,8 @@ def hash_hint(announced):
     """Why a gateway announces no type hash, for the failure message."""
     if announced != "INVALID":
         return ""
-    return (" (none announced: this rsg_gateway was configured without make deps' ROS 2 environment, as "
-            "cmake/rsg_ros2_type_hashes.cmake then says; re-run cmake)")
+    return (" (none announced: this rsg_gateway was built without the header of "
+            "cmake/rsg_ros2_type_hashes.cmake, or its type is not listed there)")
 
 
 def start_peer(h, env, label, *args):
