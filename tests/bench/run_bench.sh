@@ -36,12 +36,17 @@
 #         readers' CPU, frames published, largest ingress delay, link-down reports:
 #         bench/readers/readers_fastdds2.9.json. About 4 minutes.
 #         RSG_BENCH_READERS_SECONDS   measuring window per point (default 8)
+#   metrics  what Prometheus scraping costs rsg_gateway at 1 kHz (tests/bench/metrics_cost.py): the
+#         gateway's CPU with --metrics scraped once a second, side by side with metrics off, and the
+#         cost of one scrape (from 100 scrapes a second), alternating, over several rounds:
+#         bench/metrics/metrics_cost.json. About 5 minutes.
+#         RSG_BENCH_METRICS_ROUNDS    rounds (default 4), RSG_BENCH_METRICS_SECONDS window (default 20)
 #
 # A suite is a function run_<suite> that writes its results under $out and a function
 # report_<suite> that prints them, plus its name in SUITES.
 set -euo pipefail
 
-SUITES=(wire e2e record scale late_join readers)
+SUITES=(wire e2e record scale late_join readers metrics)
 
 here=$(cd "$(dirname "$0")" && pwd)
 usage() { echo "usage: $0 BUILD_DIR [${SUITES[*]}]" >&2; exit 2; }
@@ -155,6 +160,12 @@ run_readers() {
     --seconds "${RSG_BENCH_READERS_SECONDS:-8}" > "$out/readers.txt"
 }
 report_readers() { sed -n '/^###/,$p' "$out/readers.txt"; }
+
+run_metrics() {
+  python3 "$here/metrics_cost.py" --bin "$build/bin" --out "$out/metrics" --rounds "${RSG_BENCH_METRICS_ROUNDS:-4}" \
+    --seconds "${RSG_BENCH_METRICS_SECONDS:-20}" > "$out/metrics.txt"
+}
+report_metrics() { sed -n '/^###/,$p' "$out/metrics.txt"; }
 
 for suite in "${selected[@]}"; do
   declare -F "run_$suite" >/dev/null || { echo "$0: unknown suite '$suite'" >&2; usage; }

@@ -66,6 +66,17 @@ def realtime_prefix():
     return ["chrt", "-f", "20"] if probe.returncode == 0 else []
 
 
+def terminate(*processes, timeout_s=10):
+    """SIGTERM to each process still running (None: none started), SIGKILL after `timeout_s`."""
+    for process in processes:
+        if process and process.poll() is None:
+            process.send_signal(signal.SIGTERM)
+            try:
+                process.wait(timeout=timeout_s)
+            except subprocess.TimeoutExpired:
+                process.kill()
+
+
 def run_point(args, kind, count, domain, scratch):
     port = free_udp_port()
     stats = scratch / f"{kind}_{count}.stats.json"
@@ -129,13 +140,7 @@ def run_point(args, kind, count, domain, scratch):
             sim.wait(timeout=30)
             robot_silence_us = (read_json(sim_report) or {}).get("longest_gap_us")
     finally:
-        for process in (sim, readers):
-            if process and process.poll() is None:
-                process.send_signal(signal.SIGTERM)
-                try:
-                    process.wait(timeout=10)
-                except subprocess.TimeoutExpired:
-                    process.kill()
+        terminate(sim, readers)
         if gateway.poll() is None:
             gateway.send_signal(signal.SIGTERM)
             gateway.wait(timeout=30)
