@@ -6,8 +6,8 @@
 
 #include <cstring>
 
+#include "dds/internal/fastdds_compat.hpp"
 #include "recording_schemas.hpp"
-#include "rsg/dds/detail/fastdds_compat.hpp"
 
 namespace rsg::app {
 namespace {

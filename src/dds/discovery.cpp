@@ -6,7 +6,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::dds {

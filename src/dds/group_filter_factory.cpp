@@ -6,7 +6,7 @@
 #include <fastdds/dds/topic/IContentFilterFactory.hpp>
 #include <string>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 #include "rsg/dds/group_filter.hpp"
 #include "rsg/dds/views.hpp"
 #include "rsg/error.hpp"

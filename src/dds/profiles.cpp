@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::dds {

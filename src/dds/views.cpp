@@ -2,7 +2,7 @@
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 #include "rsg/dds/group_filter.hpp"
 #include "rsg/error.hpp"
 #include "rsg/wire/field_table.hpp"

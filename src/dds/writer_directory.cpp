@@ -8,7 +8,7 @@
 #include <mutex>
 #include <sstream>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 
 namespace rsg::dds {
 namespace fdds = eprosima::fastdds::dds;

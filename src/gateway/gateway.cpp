@@ -12,8 +12,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "dds/internal/fastdds_compat.hpp"
 #include "realtime.hpp"
-#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/discovery.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/profiles.hpp"

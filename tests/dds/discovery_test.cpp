@@ -5,7 +5,7 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <sstream>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 #include "rsg/dds/profiles.hpp"
 
 namespace rsg {

@@ -8,7 +8,7 @@
 
 #include <vector>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 #include "rsg/dds/views.hpp"
 
 namespace rsg {

@@ -15,8 +15,8 @@
 #include <thread>
 
 #include "allocation_counter.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 #include "random_state.hpp"
-#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "vectors.hpp"
 

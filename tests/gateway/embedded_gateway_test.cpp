@@ -16,8 +16,8 @@
 #include <random>
 #include <thread>
 
+#include "dds/internal/fastdds_compat.hpp"
 #include "random_state.hpp"
-#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
 

@@ -28,10 +28,10 @@
 #include <thread>
 
 #include "allocation_counter.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 #include "ingress.hpp"
 #include "pcap_file.hpp"
 #include "random_state.hpp"
-#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/ros2.hpp"
 #include "rsg/wire/frame.hpp"

@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 
+#include "dds/internal/fastdds_compat.hpp"
 #include "discovery_cli.hpp"
 #include "matched_writers.hpp"
 #include "mcap_recover.hpp"
@@ -19,7 +20,6 @@
 #include "monitor_options.hpp"
 #include "monitor_readers.hpp"
 #include "recording.hpp"
-#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"

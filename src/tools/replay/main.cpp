@@ -18,10 +18,10 @@
 #include <thread>
 #include <unordered_set>
 
+#include "dds/internal/fastdds_compat.hpp"
 #include "discovery_cli.hpp"
 #include "mcap_reader.hpp"
 #include "recording.hpp"
-#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"

@@ -16,11 +16,11 @@
 #include <optional>
 #include <sstream>
 
+#include "dds/internal/fastdds_compat.hpp"
 #include "matched_writers.hpp"
 #include "monitor_options.hpp"
 #include "monitor_readers.hpp"
 #include "recording.hpp"
-#include "rsg/dds/detail/fastdds_compat.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
 #include "rsg/transport/udp_socket.hpp"

@@ -19,7 +19,7 @@
 #include <iostream>
 #include <map>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "scenarios.hpp"
 

@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 
 namespace rsg::bench {
 namespace fdds = eprosima::fastdds::dds;

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "rsg/dds/detail/fastdds_compat.hpp"
+#include "dds/internal/fastdds_compat.hpp"
 
 namespace rsg::bench {
 namespace fdds = eprosima::fastdds::dds;

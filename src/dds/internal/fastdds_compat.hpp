@@ -1,5 +1,5 @@
-// INTERNAL, not part of rsg's API and not installed: no public header includes it; rsg's own
-// sources, tools and tests do. Its names may change in any release.
+// INTERNAL, not part of rsg's API and not installed (src/dds/internal/): rsg's own sources, tools
+// and tests include it as "dds/internal/fastdds_compat.hpp". Its names may change in any release.
 //
 // The one place where Fast DDS 2.x and 3.x differ for rsg (docs/fastdds-versions.md).
 //
