@@ -27,6 +27,8 @@ cmake -S "$source_dir/tests/packaging/consumer" -B "$work/build17" -DCMAKE_PREFI
   -DCMAKE_CXX_STANDARD=17 > "$work/configure17.log" || { cat "$work/configure17.log"; exit 1; }
 cmake --build "$work/build17" > "$work/build17.log" 2>&1 || { cat "$work/build17.log"; exit 1; }
 "$work/build/consumer"
+# A view, with the installed profiles, on a domain of its own (Fast DDS 2 or 3: what rsg was built on).
+"$work/build/view_consumer" "$work/prefix/share/rsg/xml_profiles" $(($$ % 200 + 10))
 # The embedded gateway from the installed package, with the installed profiles, on its own domain.
 "$work/build/embedded_consumer" "$work/prefix/share/rsg/xml_profiles" $(($$ % 200 + 10))
 echo "install_consumer: OK ($(echo "$installed" | wc -w) public headers)"

@@ -1,7 +1,10 @@
 // INTERNAL, not part of rsg's API and not installed (src/dds/internal/): rsg's own sources, tools
 // and tests include it as "dds/internal/fastdds_compat.hpp". Its names may change in any release.
 //
-// The one place where Fast DDS 2.x and 3.x differ for rsg (docs/fastdds-versions.md).
+// The one place where Fast DDS 2.x and 3.x differ for rsg (docs/fastdds-versions.md), together with
+// the public rsg/dds/fastdds.hpp it includes: the names a user of rsg's API needs too (return
+// codes, Duration, the rtps namespace, succeeded, RSG_FASTDDS_MAJOR) are there; what only rsg
+// needs is here.
 //
 // rsg builds against Fast DDS 2.x (package `fastrtps`: Debian 12's 2.9.1, ROS 2 Jazzy's 2.14) or 3.x
 // (package `fastdds`: Debian 13's 3.1, ROS 2 Kilted's 3.2), whichever CMake finds. The DDS API of
@@ -9,10 +12,9 @@
 // codes, `.h` -> `.hpp` RTPS headers, TopicDataType's members, the library settings, discovery
 // servers) is named here once, and the rest of the tree uses these names:
 //
-//   rsg::dds::kOk, kBadParameter, Duration, kInfinite   return codes and times
-//   rsg::dds::rtps                       the RTPS namespace (GUID_t, Locator_t, IPLocator, ...)
+//   rsg::dds::kOk, kBadParameter, Duration, kInfinite, rtps, succeeded   (rsg/dds/fastdds.hpp)
 //   rsg::dds::serialize, deserialize, max_serialized_size, is_plain, rename_type
-//   rsg::dds::succeeded, is_keyed, disable_intraprocess_delivery, read_plain_samples_in_place
+//   rsg::dds::is_keyed, disable_intraprocess_delivery, read_plain_samples_in_place
 //   rsg::dds::load_xml_profiles_file
 //   rsg::dds::add_discovery_server, discovery_server_locator, discovery_server_prefix
 //
@@ -43,39 +45,28 @@
 #include <string>
 #include <utility>
 
-#if __has_include(<fastdds/config.hpp>)
+#include "rsg/dds/fastdds.hpp"
+
+#if RSG_FASTDDS_MAJOR >= 3
 #include <fastdds/LibrarySettings.hpp>
-#include <fastdds/config.hpp>
-#include <fastdds/dds/core/ReturnCode.hpp>
-#include <fastdds/dds/core/Time_t.hpp>
 #include <fastdds/dds/xtypes/type_representation/TypeObject.hpp>
 #include <fastdds/rtps/attributes/PropertyPolicy.hpp>
 #include <fastdds/rtps/common/SerializedPayload.hpp>
 #include <fastdds/utils/IPLocator.hpp>
-/// The major version of the Fast DDS rsg is built against: 2 or 3.
-#define RSG_FASTDDS_MAJOR FASTDDS_VERSION_MAJOR
 #else
 #include <fastdds/rtps/attributes/PropertyPolicy.h>
 #include <fastdds/rtps/attributes/ServerAttributes.h>
 #include <fastdds/rtps/common/SerializedPayload.h>
 #include <fastrtps/attributes/LibrarySettingsAttributes.h>
-#include <fastrtps/config.h>
 #include <fastrtps/types/TypeObjectFactory.h>
 #include <fastrtps/utils/IPLocator.h>
 #include <fastrtps/xmlparser/XMLProfileManager.h>
-#define RSG_FASTDDS_MAJOR FASTRTPS_VERSION_MAJOR
 #endif
 
 namespace rsg::dds {
 
 #if RSG_FASTDDS_MAJOR >= 3
 
-namespace rtps = eprosima::fastdds::rtps;
-using Duration = eprosima::fastdds::dds::Duration_t;
-using ReturnCode = eprosima::fastdds::dds::ReturnCode_t;
-inline constexpr ReturnCode kOk = eprosima::fastdds::dds::RETCODE_OK;
-inline constexpr ReturnCode kBadParameter = eprosima::fastdds::dds::RETCODE_BAD_PARAMETER;
-inline const Duration kInfinite = eprosima::fastdds::dds::c_TimeInfinite;
 using DiscoveryProtocol = rtps::DiscoveryProtocol;
 
 namespace detail {
@@ -211,10 +202,6 @@ inline bool is_plain(const eprosima::fastdds::dds::TopicDataType& type) {
   return type.is_plain(eprosima::fastdds::dds::XCDR_DATA_REPRESENTATION);
 }
 
-/// Whether a call that returns a ReturnCode_t (Fast DDS 3) or a bool (Fast DDS 2: DataWriter::write)
-/// succeeded.
-inline bool succeeded(ReturnCode code) { return code == kOk; }
-
 /// Whether `type` has a key.
 inline bool is_keyed(const eprosima::fastdds::dds::TopicDataType& type) {
   return type.is_compute_key_provided;
@@ -267,12 +254,6 @@ inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& q
 
 #else  // Fast DDS 2.x
 
-namespace rtps = eprosima::fastrtps::rtps;
-using Duration = eprosima::fastrtps::Duration_t;
-using ReturnCode = eprosima::fastrtps::types::ReturnCode_t;
-inline const ReturnCode kOk = ReturnCode::RETCODE_OK;
-inline const ReturnCode kBadParameter = ReturnCode::RETCODE_BAD_PARAMETER;
-inline const Duration kInfinite = eprosima::fastrtps::c_TimeInfinite;
 using DiscoveryProtocol = rtps::DiscoveryProtocol_t;
 
 /// Fast DDS 2's DDS-SQL filter factory looks the TypeObject up by the topic's type name: registers
@@ -312,9 +293,6 @@ inline bool is_plain(const eprosima::fastdds::dds::TopicDataType& type) { return
 inline ReturnCode load_xml_profiles_file(const std::string& path) {
   return eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->load_XML_profiles_file(path);
 }
-
-inline bool succeeded(ReturnCode code) { return code == kOk; }
-inline bool succeeded(bool done) { return done; }
 
 inline bool is_keyed(const eprosima::fastdds::dds::TopicDataType& type) { return type.m_isGetKeyDefined; }
 
