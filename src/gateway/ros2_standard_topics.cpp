@@ -9,8 +9,8 @@
 #include <stdexcept>
 
 #include "ros2_type_hash.hpp"
-#include "rsg/dds/eigen.hpp"
 #include "rsg/error.hpp"
+#include "rsg/wire/eigen.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;
@@ -192,7 +192,7 @@ void Ros2StandardTopics::publish(const Snapshot& snapshot) {
   if (snapshot.outputs & kTf) {
     geometry::TransformStamped_& transform = tf_message.transforms()[0];
     transform.header().stamp(stamp);
-    const auto pose = dds::eigen::pose(snapshot.O_T_EE);  // column-major, as the frame stores it
+    const auto pose = wire::eigen::pose(snapshot.O_T_EE);  // column-major, as the frame stores it
     transform.transform().translation(vector3(pose(0, 3), pose(1, 3), pose(2, 3)));
     // A measured rotation is orthonormal to within rounding; normalising keeps the quaternion a
     // unit one (tf2 rejects others) whatever the last bits say.

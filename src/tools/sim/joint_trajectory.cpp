@@ -34,9 +34,9 @@ JointTrajectory::JointTrajectory(std::uint64_t seed) {
     weight_sum += harmonic.amplitude;
   }
 
-  const auto centre = dds::eigen::joints(panda::kReadyPose);
-  const auto position_min = dds::eigen::joints(panda::kPositionMin);
-  const auto position_max = dds::eigen::joints(panda::kPositionMax);
+  const auto centre = wire::eigen::joints(panda::kReadyPose);
+  const auto position_min = wire::eigen::joints(panda::kPositionMin);
+  const auto position_max = wire::eigen::joints(panda::kPositionMax);
   const Vector7d room = (centre - position_min).cwiseMin(position_max - centre);
   const Vector7d swing = (kLimitShare * room).cwiseMin(kMaxSwing);
 
@@ -50,15 +50,15 @@ JointTrajectory::JointTrajectory(std::uint64_t seed) {
     acceleration_peak += harmonic.amplitude.cwiseProduct(harmonic.omega).cwiseProduct(harmonic.omega);
   }
   const Vector7d velocity_scale =
-      (kLimitShare * dds::eigen::joints(panda::kVelocityMax)).cwiseQuotient(velocity_peak);
+      (kLimitShare * wire::eigen::joints(panda::kVelocityMax)).cwiseQuotient(velocity_peak);
   const Vector7d acceleration_scale =
-      (kLimitShare * dds::eigen::joints(panda::kAccelerationMax)).cwiseQuotient(acceleration_peak);
+      (kLimitShare * wire::eigen::joints(panda::kAccelerationMax)).cwiseQuotient(acceleration_peak);
   const Vector7d scale = velocity_scale.cwiseMin(acceleration_scale).cwiseMin(1.0);
   for (Harmonic& harmonic : harmonics_) harmonic.amplitude = harmonic.amplitude.cwiseProduct(scale);
 }
 
 JointState JointTrajectory::at(double t) const {
-  JointState state{dds::eigen::joints(panda::kReadyPose), Vector7d::Zero(), Vector7d::Zero(),
+  JointState state{wire::eigen::joints(panda::kReadyPose), Vector7d::Zero(), Vector7d::Zero(),
                    Vector7d::Zero()};
   for (const Harmonic& harmonic : harmonics_) {
     for (Eigen::Index joint = 0; joint < harmonic.amplitude.size(); ++joint) {

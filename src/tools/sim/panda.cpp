@@ -131,7 +131,7 @@ std::array<PointMass, kJoints + 1> point_masses(const Kinematics& kinematics) {
     const Eigen::Vector3d at = j + 1 < kJoints ? kinematics.origin(j + 1) : kinematics.flange.translation();
     masses[j] = {at, kLinkMass[j], j + 1};
   }
-  masses[kJoints] = {kinematics.flange * dds::eigen::vector3(kHandCentreOfMass), kHandMass, kJoints};
+  masses[kJoints] = {kinematics.flange * wire::eigen::vector3(kHandCentreOfMass), kHandMass, kJoints};
   return masses;
 }
 

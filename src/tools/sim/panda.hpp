@@ -7,12 +7,12 @@
 #include <array>
 #include <cstddef>
 
-#include "rsg/dds/eigen.hpp"
+#include "rsg/wire/eigen.hpp"
 
 namespace rsg::tools::sim::panda {
 
-using dds::eigen::Vector6d;
-using dds::eigen::Vector7d;
+using wire::eigen::Vector6d;
+using wire::eigen::Vector7d;
 
 inline constexpr std::size_t kJoints = 7;
 

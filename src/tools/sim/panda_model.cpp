@@ -86,13 +86,13 @@ void PandaModel::fill(std::chrono::nanoseconds since_start, const wire::Selectio
   writer.put(wire::Field::F_T_EE, panda::flange_to_end_effector().matrix());
   writer.put(wire::Field::EE_T_K, Eigen::Matrix4d::Identity());
   writer.put(wire::Field::m_ee, panda::kHandMass);
-  writer.put(wire::Field::I_ee, dds::eigen::inertia(panda::kHandInertia));
-  writer.put(wire::Field::F_x_Cee, dds::eigen::vector3(panda::kHandCentreOfMass));
+  writer.put(wire::Field::I_ee, wire::eigen::inertia(panda::kHandInertia));
+  writer.put(wire::Field::F_x_Cee, wire::eigen::vector3(panda::kHandCentreOfMass));
   for (wire::Field field : kRestingFields) writer.put_zero(field);
   // Without a load, the total is the hand alone.
   writer.put(wire::Field::m_total, panda::kHandMass);
-  writer.put(wire::Field::I_total, dds::eigen::inertia(panda::kHandInertia));
-  writer.put(wire::Field::F_x_Ctotal, dds::eigen::vector3(panda::kHandCentreOfMass));
+  writer.put(wire::Field::I_total, wire::eigen::inertia(panda::kHandInertia));
+  writer.put(wire::Field::F_x_Ctotal, wire::eigen::vector3(panda::kHandCentreOfMass));
   writer.put(wire::Field::elbow, elbow(measured.position));
   writer.put(wire::Field::elbow_d, elbow(desired.position));
   writer.put(wire::Field::elbow_c, elbow(desired.position));

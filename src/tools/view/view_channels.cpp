@@ -3,8 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include "recording_schemas.hpp"
-#include "rsg/dds/eigen.hpp"
 #include "rsg/dds/robot_state.hpp"
+#include "rsg/wire/eigen.hpp"
 #include "rsg/wire/error_flags.hpp"
 #include "status_sample.hpp"
 
@@ -65,7 +65,7 @@ ChannelSet::ChannelSet(const std::string& state_topic, const std::string& status
 
 std::optional<std::string> frame_transform_json(const RobotState& sample, std::uint64_t time_ns) {
   if (!dds::selection_of(sample).contains(wire::Field::O_T_EE)) return std::nullopt;
-  const Eigen::Isometry3d pose = dds::eigen::isometry(sample.O_T_EE());
+  const Eigen::Isometry3d pose = wire::eigen::isometry(sample.O_T_EE());
   const Eigen::Vector3d t = pose.translation();
   // A frame from a real controller holds a rotation; normalizing keeps Foxglove's 3D panel sane otherwise.
   const Eigen::Quaterniond r = Eigen::Quaterniond(pose.linear()).normalized();
@@ -90,7 +90,7 @@ void PageSummary::add(const RobotState& sample) {
   if (selection.contains(wire::Field::dq)) dq_ = sample.dq();
   if (selection.contains(wire::Field::tau_J)) tau_J_ = sample.tau_J();
   if (selection.contains(wire::Field::O_T_EE)) {
-    const Eigen::Vector3d t = dds::eigen::pose(sample.O_T_EE()).block<3, 1>(0, 3);
+    const Eigen::Vector3d t = wire::eigen::pose(sample.O_T_EE()).block<3, 1>(0, 3);
     ee_position_ = std::array<double, 3>{t.x(), t.y(), t.z()};
   }
   if (selection.contains(wire::Field::control_command_success_rate))

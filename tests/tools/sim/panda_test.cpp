@@ -26,7 +26,7 @@ TEST(PandaKinematics, ZeroPoseStandsUpright) {
 TEST(PandaKinematics, ReadyPoseMatchesFranka) {
   // libfranka reports O_T_EE = [0.3069, 0, 0.4869] pointing down, hand axes aligned with the base,
   // in the ready pose with the Franka Hand.
-  const panda::Kinematics kinematics = panda::forward_kinematics(dds::eigen::joints(panda::kReadyPose));
+  const panda::Kinematics kinematics = panda::forward_kinematics(wire::eigen::joints(panda::kReadyPose));
   EXPECT_NEAR(kinematics.flange.translation().x(), 0.3069, kPoseTolerance);
   EXPECT_NEAR(kinematics.flange.translation().y(), 0.0, kPoseTolerance);
   EXPECT_NEAR(kinematics.flange.translation().z(), 0.5903, kPoseTolerance);
@@ -51,7 +51,7 @@ TEST(PandaKinematics, FirstJointFeelsNoGravity) {
 
 TEST(PandaKinematics, ShoulderHoldsTheArmInTheReadyPose) {
   // Leaning forward, joint 2 carries most of the ~18 kg arm's moment: tens of Nm.
-  const Vector7d torque = panda::forward_kinematics(dds::eigen::joints(panda::kReadyPose)).gravity_torque();
+  const Vector7d torque = panda::forward_kinematics(wire::eigen::joints(panda::kReadyPose)).gravity_torque();
   EXPECT_GT(std::abs(torque[1]), 5.0);
   EXPECT_LT(std::abs(torque[1]), 80.0);
 }
@@ -105,14 +105,14 @@ TEST(JointTrajectory, StaysStrictlyInsideTheLimitsForAnHour) {
     const JointTrajectory trajectory(seed);
     for (double t = 0; t < 3600; t += 0.02) {
       const JointState state = trajectory.at(t);
-      ASSERT_TRUE((state.position.array() > dds::eigen::joints(panda::kPositionMin).array()).all())
+      ASSERT_TRUE((state.position.array() > wire::eigen::joints(panda::kPositionMin).array()).all())
           << "t = " << t;
-      ASSERT_TRUE((state.position.array() < dds::eigen::joints(panda::kPositionMax).array()).all())
+      ASSERT_TRUE((state.position.array() < wire::eigen::joints(panda::kPositionMax).array()).all())
           << "t = " << t;
       ASSERT_TRUE(
-          (state.velocity.cwiseAbs().array() < dds::eigen::joints(panda::kVelocityMax).array()).all());
+          (state.velocity.cwiseAbs().array() < wire::eigen::joints(panda::kVelocityMax).array()).all());
       ASSERT_TRUE(
-          (state.acceleration.cwiseAbs().array() < dds::eigen::joints(panda::kAccelerationMax).array())
+          (state.acceleration.cwiseAbs().array() < wire::eigen::joints(panda::kAccelerationMax).array())
               .all());
     }
   }

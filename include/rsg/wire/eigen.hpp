@@ -1,7 +1,9 @@
-// Zero-copy Eigen views of RobotState arrays.
+// Zero-copy Eigen views of a robot state's arrays: a RobotState sample's members, the arrays of the
+// wire layer's field table (the frame's layout; no DDS involved). Link rsg::eigen (find_package(rsg
+// COMPONENTS eigen)), which brings Eigen; rsg's other libraries do not need Eigen.
 //
-//   const Eigen::Vector3d position = rsg::dds::eigen::pose(sample.O_T_EE()).block<3, 1>(0, 3);
-//   rsg::dds::eigen::joints(sample.q())   // Map<const Vector7d>, no copy
+//   const Eigen::Vector3d position = rsg::wire::eigen::pose(sample.O_T_EE()).block<3, 1>(0, 3);
+//   rsg::wire::eigen::joints(sample.q())   // Map<const Vector7d>, no copy
 //
 // The frame stores matrices column-major, as Eigen does by default, so a Map is the matrix:
 // the translation of a pose is at elements 12..14.
@@ -11,7 +13,7 @@
 #include <Eigen/Geometry>
 #include <array>
 
-namespace rsg::dds::eigen {
+namespace rsg::wire::eigen {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Vector7d = Eigen::Matrix<double, 7, 1>;
@@ -59,4 +61,4 @@ inline Eigen::Map<const Vector7d> joints(const std::array<double, 7>& v) {
 }
 inline Eigen::Map<Vector7d> joints(std::array<double, 7>& v) { return Eigen::Map<Vector7d>(v.data()); }
 
-}  // namespace rsg::dds::eigen
+}  // namespace rsg::wire::eigen
