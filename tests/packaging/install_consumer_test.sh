@@ -26,6 +26,12 @@ cmake --build "$work/build" > "$work/build.log" 2>&1 || { cat "$work/build.log";
 cmake -S "$source_dir/tests/packaging/consumer" -B "$work/build17" -DCMAKE_PREFIX_PATH="$work/prefix" \
   -DCMAKE_CXX_STANDARD=17 > "$work/configure17.log" || { cat "$work/configure17.log"; exit 1; }
 cmake --build "$work/build17" > "$work/build17.log" 2>&1 || { cat "$work/build17.log"; exit 1; }
+# The client libraries alone ask for no component, and find none of the components' dependencies.
+cmake -S "$source_dir/tests/packaging/consumer" -B "$work/build_core" -DCMAKE_PREFIX_PATH="$work/prefix" \
+  -DRSG_CONSUMER_EMBEDDED=OFF -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
+  -DCMAKE_DISABLE_FIND_PACKAGE_yaml-cpp=ON -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON \
+  -DCMAKE_DISABLE_FIND_PACKAGE_nlohmann_json=ON > "$work/configure_core.log" || { cat "$work/configure_core.log"; exit 1; }
+cmake --build "$work/build_core" > "$work/build_core.log" 2>&1 || { cat "$work/build_core.log"; exit 1; }
 "$work/build/consumer"
 # A view, with the installed profiles, on a domain of its own (Fast DDS 2 or 3: what rsg was built on).
 "$work/build/view_consumer" "$work/prefix/share/rsg/xml_profiles" $(($$ % 200 + 10))

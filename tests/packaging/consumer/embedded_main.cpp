@@ -1,5 +1,6 @@
 // A controller outside rsg, built against the installed package: starts rsg::gateway::EmbeddedGateway on
-// a port the kernel picks, sends it one frame and exits 0 when the callback saw that frame.
+// a port the kernel picks, sends it one frame and exits 0 when the callback saw that frame (read
+// through rsg::eigen's views: the package's two components).
 //
 //   embedded_consumer PROFILES_DIR DOMAIN
 #include <array>
@@ -10,6 +11,7 @@
 #include <thread>
 
 #include "rsg/gateway/embedded_gateway.hpp"
+#include "rsg/wire/eigen.hpp"
 #include "rsg/wire/state_values.hpp"
 
 int main(int argc, char** argv) {
@@ -19,7 +21,7 @@ int main(int argc, char** argv) {
   rsg::gateway::EmbeddedGateway gateway("listen: 127.0.0.1:0\nlog-level: warn\nprofiles: " +
                                             std::string(argv[1]) + "\ndomain: " + argv[2] + "\n",
                                         [&](const rsg::RobotState& state) {
-                                          q0 = state.q()[0];
+                                          q0 = rsg::wire::eigen::joints(state.q())(0);
                                           ++seen;
                                         });
 
