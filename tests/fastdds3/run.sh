@@ -29,10 +29,12 @@ logs=$build/test-fastdds3
 integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors|late_joiner"
 integration+="|rate_topic|demo|realtime_gateway|embedded_controller"
 processes="views\.rsg_echo|interop\.cyclone|integration\.($integration)|ros2\.(standard_topics|msg_matches_field_table)"
-processes+="|gateway\.embedded|cli\.rsg_frame"
+processes+="|gateway\.embedded|cli\.rsg_frame|packaging\.install_consumer"
+# rsg_record, rsg_replay and rsg_embedded_gateway complete what `cmake --install` installs, for
+# packaging.install_consumer (its consumers, a view reader among them, built against the installed 3.x tree).
 targets=(unit_tests rsg_gateway rsg_sim rsg_echo rsg_frame rsg_status_probe rsg_views_publish rsg_view
          rsg_cyclone_echo rsg_cyclone_publish rsg_example_embedded_controller rsg_ros2_standard_echo
-         rsg_generate_msg)
+         rsg_generate_msg rsg_record rsg_replay rsg_embedded_gateway)
 
 passed=0
 failed=0
@@ -66,8 +68,8 @@ echo "test-fastdds3: built in the chroot in $((SECONDS - start)) s"
 
 # 2. In the chroot: Fast DDS 3.1.2 on both ends.
 # Not here: IngressAllocation.* (Fast DDS 3.1.2 allocates inside DataWriter::write(), the zero-allocation
-# claim is 2.9's: docs/fastdds-versions.md) and packaging (installs the whole tree; only the targets
-# above are built).
+# claim is 2.9's: docs/fastdds-versions.md) and packaging (it checks Debian 12's package lists);
+# packaging.install_consumer runs with the process tests below.
 $chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -L unit -E '^(IngressAllocation\..*|packaging)\$'" 2>&1 | tee "$logs/unit.log" | tail -n 3
 count_ctest "$logs/unit.log"
 $chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -R '^($processes)\$'" \
