@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "dds/internal/fastdds_compat.hpp"
+#include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"

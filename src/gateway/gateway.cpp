@@ -12,9 +12,9 @@
 #include <stdexcept>
 #include <thread>
 
-#include "dds/internal/fastdds_compat.hpp"
 #include "realtime.hpp"
 #include "rsg/dds/discovery.hpp"
+#include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/ros2.hpp"

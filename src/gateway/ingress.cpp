@@ -5,6 +5,7 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <stdexcept>
 
+#include "dds/internal/fastdds_compat.hpp"  // is_plain
 #include "ros2_type_hash.hpp"
 #include "rsg/error.hpp"
 

@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "dds/internal/fastdds_compat.hpp"
+#include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/views.hpp"
 #include "rsg_ros2_type_hashes.hpp"
 

@@ -6,6 +6,7 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <stdexcept>
 
+#include "dds/internal/fastdds_compat.hpp"  // rename_type
 #include "ros2_type_hash.hpp"
 #include "rsg/error.hpp"
 #include "status_sample.hpp"

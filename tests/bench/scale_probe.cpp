@@ -30,9 +30,9 @@
 #include <iostream>
 #include <vector>
 
-#include "dds/internal/fastdds_compat.hpp"
 #include "discovery_cli.hpp"
 #include "e2e/stamped_frames.hpp"
+#include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"

@@ -8,8 +8,8 @@
 #include <random>
 #include <vector>
 
-#include "dds/internal/fastdds_compat.hpp"
 #include "random_state.hpp"
+#include "rsg/dds/fastdds.hpp"
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/state_values.hpp"
 

@@ -10,7 +10,7 @@
 #include <set>
 #include <vector>
 
-#include "dds/internal/fastdds_compat.hpp"
+#include "rsg/dds/fastdds.hpp"
 
 // The transport API is the one place of rsg's tests where Fast DDS 2 and 3 differ beyond names:
 // 3.x hands a message over as a list of buffers (and renamed the headers).

@@ -17,6 +17,7 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
+#include "dds/internal/fastdds_compat.hpp"  // disable_intraprocess_delivery
 #include "mixed_stream.hpp"
 #include "rsg/dds/group_filter.hpp"
 #include "rsg/dds/participant.hpp"

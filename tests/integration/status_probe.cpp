@@ -9,7 +9,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <iostream>
 
-#include "dds/internal/fastdds_compat.hpp"
+#include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "status_sample.hpp"

@@ -21,10 +21,10 @@
 #include <stop_token>
 #include <thread>
 
-#include "dds/internal/fastdds_compat.hpp"
 #include "discovery_cli.hpp"
 #include "live_table.hpp"
 #include "matched_writers.hpp"
+#include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"

@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "dds/internal/fastdds_compat.hpp"
+#include "rsg/dds/fastdds.hpp"
 
 namespace rsg::bench {
 namespace fdds = eprosima::fastdds::dds;

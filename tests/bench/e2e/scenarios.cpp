@@ -19,10 +19,10 @@
 
 #include "../floor/relay_loop.hpp"
 #include "child_process.hpp"
-#include "dds/internal/fastdds_compat.hpp"
 #include "latency_log.hpp"
 #include "process_usage.hpp"
 #include "ros2_standard_readers.hpp"
+#include "rsg/dds/fastdds.hpp"
 #include "rsg/gateway/embedded_gateway.hpp"
 #include "rsg/transport/udp_socket.hpp"
 #include "stamped_frames.hpp"

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "dds/internal/fastdds_compat.hpp"
+#include "rsg/dds/fastdds.hpp"
 
 namespace rsg::bench {
 namespace fdds = eprosima::fastdds::dds;

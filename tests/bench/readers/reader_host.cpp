@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "../e2e/stamped_frames.hpp"
-#include "dds/internal/fastdds_compat.hpp"
+#include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
