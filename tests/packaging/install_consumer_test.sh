@@ -15,6 +15,8 @@ installed=$(cd "$work/prefix/include/rsg" && find . -name '*.hpp' | sort)
 for header in $installed; do
   case "$header" in ./error.hpp | ./wire/* | ./transport/* | ./dds/* | ./idl/* | ./gateway/embedded_gateway.hpp) ;; *) echo "FAIL: internal header installed: $header"; exit 1 ;; esac
 done
+# No installed header reaches for what is not installed (src/<layer>/internal/, CONTRIBUTING.md).
+if grep -rn '#include "[a-z]*/internal/' "$work/prefix/include"; then echo "FAIL: an installed header includes an internal one"; exit 1; fi
 for tool in rsg_gateway rsg_sim rsg_echo rsg_frame rsg_record rsg_replay rsg_view; do
   [[ -x "$work/prefix/bin/$tool" ]] || { echo "FAIL: $tool not installed"; exit 1; }
 done
