@@ -47,7 +47,7 @@ deps-run:
 
 # Everything make test needs: Debian packages, npm packages, the Python environments and Go tools.
 deps: deps-run
-	$(call apt_install,test)
+	$(call apt_install,test package)
 	@# Node and npm for the tests that read MCAP files with @mcap/core (Debian's, unless a node is there).
 	@command -v npm >/dev/null || { $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends nodejs npm; }
@@ -141,3 +141,21 @@ image:
 # Builds the image, then runs the pipeline, rsg_view and docker/compose.yaml in containers.
 test-image: deps
 	RSG_IMAGE=$(IMAGE) tests/image/run.sh
+
+# The Debian package (cmake/rsg_package.cmake, docs/service.md): a Release build of its own without
+# the tests, the man pages from help2man, CPack's DEB generator (version: project(), Depends:
+# dpkg-shlibdeps), then lintian, which must report no error. The .deb is in $(PKG_BUILD)/packages/.
+PKG_BUILD ?= build-pkg
+.PHONY: package test-service
+package: deps-run
+	$(call apt_install,package)
+	cmake -S . -B $(PKG_BUILD) -DCMAKE_BUILD_TYPE=Release -DRSG_BUILD_TESTS=OFF -DCMAKE_INSTALL_PREFIX=/usr $(CMAKE_COMMON)
+	cmake --build $(PKG_BUILD) -j $(JOBS) --target all rsg_man
+	rm -rf $(PKG_BUILD)/packages
+	cd $(PKG_BUILD) && cpack -G DEB
+	lintian --fail-on error --info $(PKG_BUILD)/packages/rsg_*.deb
+
+# The package under a real systemd as PID 1 (tests/service/run.sh): installed with apt-get into a
+# clean Debian 12 container, the unit started, fed, killed, frozen, broken, upgraded and purged.
+test-service: deps package
+	PKG_BUILD=$(PKG_BUILD) tests/service/run.sh
