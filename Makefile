@@ -157,5 +157,7 @@ package: deps-run
 
 # The package under a real systemd as PID 1 (tests/service/run.sh): installed with apt-get into a
 # clean Debian 12 container, the unit started, fed, killed, frozen, broken, upgraded and purged.
-test-service: deps package
+# Needs podman, runc and debootstrap (test.txt), not the rest of make deps.
+test-service: package
+	$(call apt_install,test)
 	PKG_BUILD=$(PKG_BUILD) tests/service/run.sh
