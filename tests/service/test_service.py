@@ -11,7 +11,8 @@ the ones before left:
   ready         the instance robot1 enabled and started: `active` only after READY=1, i.e. the
                 first time systemd says active, the stats file exists and the UDP port is bound;
                 systemd's StatusText is the gateway's STATUS= line
-  frames        frames sent from the host arrive exact at rsg_echo --json on the host
+  frames        frames sent from the host arrive exact at rsg_echo --json on the host; the
+                gateway's "link up" is in the journal at priority info, not among the warnings
   sigkill       the gateway killed with SIGKILL: systemd restarts it, and the same rsg_echo
                 receives the next frames exact
   watchdog      the gateway frozen with SIGSTOP: systemd's watchdog kills it ("Watchdog timeout" in
@@ -19,7 +20,7 @@ the ones before left:
   upgrade       apt-get install of the current .deb over the older one: the running instance is
                 restarted by postinst on the new version and frames arrive exact
   broken        an instance with a configuration the gateway refuses: its start fails, the error
-                is in `journalctl -u`, and after StartLimitBurst (5) starts systemd gives up
+                is in `journalctl -u` at priority err, and after StartLimitBurst (5) starts systemd gives up
                 ("Start request repeated too quickly") instead of restarting forever
   purge         apt-get purge: no process, unit, file, directory, user or group left that was not
                 there before the install (the Depends stay: the listing is taken after apt-get
@@ -267,6 +268,11 @@ class Run:
         self.start_echo(4 * FRAMES)
         self.wait_matched(0)
         self.send_and_check("frames")
+        # The journal has the gateway's info lines at priority info, not among the warnings.
+        infos = self.box.sh(f"journalctl -u {UNIT} -p info --no-pager -o cat")
+        warnings = self.box.sh(f"journalctl -u {UNIT} -p warning --no-pager -o cat")
+        check("link up" in infos and "link up" not in warnings,
+              f"'link up' is not an info line of the journal:\n{infos[-1500:]}\n-- warnings:\n{warnings[-1500:]}")
 
     def sigkill(self):
         pid = self.box.main_pid()
@@ -328,6 +334,9 @@ class Run:
                  interval_s=0.5)
         journal = self.box.journal(BROKEN)
         check("no-such-key" in journal, f"the gateway's error is not in journalctl -u {BROKEN}:\n{journal[-2000:]}")
+        # ... at the error priority (the gateway's <3> prefix on the journal's stream).
+        errors = self.box.sh(f"journalctl -u {BROKEN} -p err --no-pager -o cat", check_status=False)
+        check("no-such-key" in errors, f"the gateway's error is not at priority err in the journal:\n{errors[-2000:]}")
         starts = journal.count("Starting rsg-gateway@broken.service")
         check(starts == START_LIMIT_BURST, f"{starts} starts of {BROKEN}, not StartLimitBurst={START_LIMIT_BURST}")
         time.sleep(3 * 2)  # three RestartSec: a loop would have started it again
