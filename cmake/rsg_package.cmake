@@ -53,6 +53,8 @@ install(FILES deploy/systemd/realtime.conf DESTINATION ${CMAKE_INSTALL_DATADIR}/
         EXCLUDE_FROM_ALL)
 # The example configuration: /etc/rsg/robot1.yaml, a conffile (dpkg keeps the operator's edits on upgrade).
 install(FILES deploy/systemd/robot1.yaml DESTINATION /etc/rsg COMPONENT deb EXCLUDE_FROM_ALL)
+# ... and as it was shipped, to start a second robot's from.
+install(FILES deploy/systemd/robot1.yaml DESTINATION ${CMAKE_INSTALL_DATADIR}/rsg/examples COMPONENT deb EXCLUDE_FROM_ALL)
 
 # Debian's copyright file (machine-readable, pointing at the system's Apache-2.0 text rather than
 # holding it) and changelog: a native package's is /usr/share/doc/rsg/changelog.gz, with the user's

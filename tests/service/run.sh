@@ -16,6 +16,18 @@ debs=("$build"/packages/rsg_*.deb)
 [[ ${#debs[@]} -eq 1 ]] || { echo "test-service: expected one $build/packages/rsg_*.deb (make package), found ${#debs[@]}" >&2; exit 1; }
 deb=${debs[0]}
 version=$(dpkg-deb -f "$deb" Version)
+
+# The package itself: a man page for every tool in /usr/bin, and lintian's warnings exactly the
+# ones docs/service.md lists and justifies (make package already failed on any error).
+contents=$(dpkg-deb -c "$deb" | awk '{ print $6 }')
+for tool in $(grep -oE '^\./usr/bin/[^/]+$' <<< "$contents" | xargs -n1 basename); do
+  grep -qx "./usr/share/man/man1/$tool.1.gz" <<< "$contents" || { echo "test-service: no man page for $tool in $deb" >&2; exit 1; }
+done
+allowed='maintainer-script-calls-systemctl'
+tags=$(lintian "$deb" 2> /dev/null | awk '$1 ~ /^[EW]:$/ { print $3 }' | sort -u)
+unlisted=$(grep -vxE "$allowed" <<< "$tags" || true)
+[[ -z "$unlisted" ]] || { echo "test-service: lintian tags not listed in docs/service.md: $unlisted" >&2; exit 1; }
+echo "test-service: $(basename "$deb"): a man page per tool; lintian: ${tags:-nothing} (listed in docs/service.md)"
 work=$(mktemp -d "${TMPDIR:-/tmp}/rsg-service.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 cp "$deb" "$work/"
