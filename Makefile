@@ -47,7 +47,7 @@ deps-run:
 
 # Everything make test needs: Debian packages, npm packages, the Python environments and Go tools.
 deps: deps-run
-	$(call apt_install,test)
+	$(call apt_install,test package)
 	@# Node and npm for the tests that read MCAP files with @mcap/core (Debian's, unless a node is there).
 	@command -v npm >/dev/null || { $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends nodejs npm; }
@@ -119,7 +119,7 @@ format:
 	git ls-files '*.cpp' '*.hpp' '*.h' '*.c' | xargs clang-format -i
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) $(DEMO_BUILD) build-fdds3 build-time
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) $(DEMO_BUILD) build-fdds3 build-time $(PKG_BUILD)
 
 # Fast DDS 3 (Debian 13's 3.1.2) in a cached trixie chroot, and across versions with $(BUILD)'s
 # 2.9.1 on the host (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/.
@@ -141,3 +141,31 @@ image:
 # Builds the image, then runs the pipeline, rsg_view and docker/compose.yaml in containers.
 test-image: deps
 	RSG_IMAGE=$(IMAGE) tests/image/run.sh
+
+# The Debian package (cmake/rsg_package.cmake, docs/service.md): a Release build of its own without
+# the tests, the man pages from help2man, CPack's DEB generator (version: project(), Depends:
+# dpkg-shlibdeps), then lintian, which must report no error. The .deb is in $(PKG_BUILD)/packages/.
+# Compiled with Debian's build flags with every hardening option (dpkg-buildflags: fortify, stack
+# protector, relro, bindnow), as a package built by debhelper would be, less -g (CPack strips the
+# binaries: debug info would only slow the build), -O2 (Release's -O3) and -ffile-prefix-map.
+PKG_BUILD ?= build-pkg
+PKG_FLAGS = $$(DEB_BUILD_MAINT_OPTIONS=hardening=+all dpkg-buildflags --get $(1) | tr ' ' '\n' | \
+              grep -vE '^(-g|-O2|-ffile-prefix-map=.*)$$' | tr '\n' ' ')
+.PHONY: package test-service
+package: deps-run
+	$(call apt_install,package)
+	cmake -S . -B $(PKG_BUILD) -DCMAKE_BUILD_TYPE=Release -DRSG_BUILD_TESTS=OFF -DCMAKE_INSTALL_PREFIX=/usr $(CMAKE_COMMON) \
+	  -DCMAKE_C_FLAGS="$(call PKG_FLAGS,CPPFLAGS) $(call PKG_FLAGS,CFLAGS)" \
+	  -DCMAKE_CXX_FLAGS="$(call PKG_FLAGS,CPPFLAGS) $(call PKG_FLAGS,CXXFLAGS)" \
+	  -DCMAKE_EXE_LINKER_FLAGS="$(call PKG_FLAGS,LDFLAGS)"
+	cmake --build $(PKG_BUILD) -j $(JOBS) --target all rsg_man
+	rm -rf $(PKG_BUILD)/packages
+	cd $(PKG_BUILD) && cpack -G DEB
+	lintian --fail-on error --info $(PKG_BUILD)/packages/rsg_*.deb
+
+# The package under a real systemd as PID 1 (tests/service/run.sh): installed with apt-get into a
+# clean Debian 12 container, the unit started, fed, killed, frozen, broken, upgraded and purged.
+# Needs podman, runc and debootstrap (test.txt), not the rest of make deps.
+test-service: package
+	$(call apt_install,test)
+	PKG_BUILD=$(PKG_BUILD) tests/service/run.sh

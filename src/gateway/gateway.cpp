@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "errno_text.hpp"
 #include "realtime.hpp"
 #include "rsg/dds/discovery.hpp"
 #include "rsg/dds/fastdds.hpp"
@@ -42,12 +43,6 @@ transport::Endpoint resolve(const std::string& flag, const std::string& host_por
 
 double unix_now_s() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
-// errno as "No such file or directory (ENOENT)".
-std::string errno_text(int error) {
-  const char* name = ::strerrorname_np(error);
-  return std::string(std::strerror(error)) + " (" + (name != nullptr ? name : std::to_string(error)) + ")";
 }
 
 // A directory the gateway will write into must exist and be writable: said at start-up, naming the
@@ -235,7 +230,8 @@ Gateway::Gateway(const GatewaySetup& setup)
       participant_(config_.domain, participant_qos(config_)),
       status_(check_entity_profiles(participant_, config_), status_topic_of(config_), partitions_of(config_),
               config_.status_profile,
-              config_.ros2 ? std::string(dds::kRos2GatewayStatusType) : std::string()) {
+              config_.ros2 ? std::string(dds::kRos2GatewayStatusType) : std::string()),
+      stats_file_(config_.stats_file) {
   if (setup.ingress) {
     ingress_.emplace(participant_, *setup.ingress);
     spdlog::info("ingress: frames on UDP {} -> topic '{}' (domain {})",
@@ -267,7 +263,7 @@ void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump, LoopOb
   rate_.update(0, start);
   const GatewayStats first = snapshot();
   status_.publish(first);
-  write_stats_file(first);  // before READY: a stats file exists once the gateway is up
+  stats_file_.write_now(first);  // before READY: a stats file exists once the gateway is up
   if (metrics_) metrics_->publish(metrics_snapshot(first, start));
   if (observer != nullptr) observer->started(first, ingress_.has_value());
   auto next_status = start + kStatusPeriod;
@@ -297,7 +293,7 @@ void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump, LoopOb
   if (observer != nullptr) observer->stopping();
   const GatewayStats final_stats = snapshot();
   status_.publish(final_stats);
-  write_stats_file(final_stats);
+  stats_file_.write_now(final_stats);
   spdlog::info("stopping: {}", summary_line(final_stats));
 }
 
@@ -331,7 +327,7 @@ GatewayStats Gateway::on_status_period(Clock::time_point now) {
   const GatewayStats stats = snapshot();
   if (ingress_) ingress_->end_status_period();
   status_.publish(stats);
-  write_stats_file(stats);
+  stats_file_.post(stats);  // written by its own thread: never a disk wait here
   if (metrics_) metrics_->publish(metrics_snapshot(stats, now));
   if (no_link_)
     if (const auto warning = no_link_->due(stats, now)) spdlog::warn("{}", *warning);
@@ -379,30 +375,6 @@ void enter_realtime_mode(const GatewayConfig& config) {
   if (outcome.pinned)
     done += (done.empty() ? "" : ", ") + std::string("on CPU ") + std::to_string(request.cpu);
   spdlog::info("real-time mode: ingress thread {}", done);
-}
-
-void Gateway::write_stats_file(const GatewayStats& stats) {
-  if (config_.stats_file.empty()) return;
-  // Written aside and renamed, so that a reader never sees half a file.
-  const std::string& target = config_.stats_file;
-  const std::string partial = target + ".partial";
-  const std::string text = to_json(stats) + '\n';
-  const auto failed = [&](const std::string& file) {
-    const int error = errno;
-    // Once per cause, not every second; and once again when it works again.
-    if (std::exchange(stats_file_errno_, error) != error)
-      spdlog::warn("cannot write {}: {}", file, errno_text(error));
-  };
-  std::FILE* out = std::fopen(partial.c_str(), "w");
-  if (out == nullptr) return failed(partial);
-  const bool written = std::fwrite(text.data(), 1, text.size(), out) == text.size();
-  const int write_error = errno;
-  if (std::fclose(out) != 0 || !written) {
-    if (!written) errno = write_error;
-    return failed(partial);
-  }
-  if (std::rename(partial.c_str(), target.c_str()) != 0) return failed(target);
-  if (std::exchange(stats_file_errno_, 0) != 0) spdlog::info("writing {} again", target);
 }
 
 }  // namespace rsg::gateway

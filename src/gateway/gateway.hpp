@@ -15,6 +15,7 @@
 #include "loop_observer.hpp"
 #include "metrics_server.hpp"
 #include "no_link_warning.hpp"
+#include "stats_file.hpp"
 #include "status_publisher.hpp"
 
 namespace rsg::gateway {
@@ -55,7 +56,6 @@ class Gateway {
   void dump_flight_recorder(std::string_view reason);
   GatewayStats on_status_period(Clock::time_point now);  // returns the stats it reported
   GatewayStats snapshot() const;
-  void write_stats_file(const GatewayStats& stats);
   MetricsSnapshot metrics_snapshot(const GatewayStats& stats, Clock::time_point now) const;
 
   GatewayConfig config_;
@@ -67,7 +67,7 @@ class Gateway {
   double rate_hz_ = 0;
   Clock::time_point next_summary_{};
   std::optional<NoLinkWarning> no_link_;  // with ingress
-  int stats_file_errno_ = 0;              // of the last failed write of the stats file; 0: it worked
+  StatsFile stats_file_;                  // --stats-file, written by a thread of its own
   double link_last_change_s_ = 0;         // Unix time, for the metrics
   std::optional<MetricsServer> metrics_;  // last: serves snapshots of everything above
 };

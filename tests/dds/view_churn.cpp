@@ -4,9 +4,12 @@
 // must carry the view's groups. Prints "cycles N samples M wrong W" and exits 1 when a view
 // received a sample without its groups, or 2 for usage errors.
 #include <RobotState.h>
+#include <execinfo.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
@@ -21,7 +24,28 @@
 #include "rsg/dds/ros2.hpp"
 #include "rsg/dds/views.hpp"
 
+namespace {
+
+// A crash of this process is a finding (issue 29: readers that come and go must not crash anyone),
+// and the test's log is all CI keeps: the stack goes to stderr before the default action dumps core.
+void print_stack_and_die(int signal) {
+  void* frames[64];
+  const int count = ::backtrace(frames, 64);
+  static constexpr char kHeader[] = "rsg_views_churn: fatal signal, stack:\n";
+  [[maybe_unused]] const auto written = ::write(STDERR_FILENO, kHeader, sizeof kHeader - 1);
+  ::backtrace_symbols_fd(frames, count, STDERR_FILENO);
+  std::signal(signal, SIG_DFL);
+  std::raise(signal);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  {
+    void* warm[1];
+    ::backtrace(warm, 1);  // loads libgcc's unwinder now, not inside the signal handler
+  }
+  for (const int signal : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE}) std::signal(signal, print_stack_and_die);
   int domain = 0;
   std::string topic_name = "robot_state";
   std::vector<std::string> partitions;

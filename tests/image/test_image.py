@@ -3,7 +3,10 @@ over loopback and the host's /dev/shm (what docker/compose.yaml sets).
 
   pipeline      rsg_sim -> rsg_gateway -> rsg_echo --json and rsg_record: every frame exact at the
                 echo, the MCAP file read by the reference reader (tests/record/check_recording.mjs)
-                to the values sent; the image's HEALTHCHECK passes on the running gateway
+                to the values sent
+  health        the image's HEALTHCHECK (GET /healthz on the gateway's metrics port): unhealthy
+                before the robot streams, healthy while rsg_sim streams, unhealthy again once it
+                stops; healthy in a container of another tool
   view_and_restart
                 rsg_view serves its page to Debian's headless Chromium on the host
                 (tests/rsg_view/check_page.mjs): live samples rsg_sim sent, plotted by Chart.js; then
@@ -73,9 +76,12 @@ class Containers:
         for path in (self.data, self.stats_dir):
             path.chmod(0o777)
         self.stats = self.stats_dir / "gateway-stats.json"
+        # The entrypoint's --metrics 127.0.0.1:$RSG_METRICS_PORT, where the HEALTHCHECK asks /healthz:
+        # a port of this run (the host network is shared with every other test's gateways).
+        self.metrics_port = free_tcp_port()
         # Domains 210-230: none of ctest's (harness.test_domain: 10-209), one per case, so that no
         # other test's gateway and no earlier case's writer is matched.
-        self.domain = 210 + os.getpid() % 7 * 3 + sorted(CASES).index(case)
+        self.domain = 210 + os.getpid() % 5 * 4 + sorted(CASES).index(case)
         self.prefix = f"rsg-image-test-{os.getpid()}-{case.replace('_', '-')}"
         self.processes = {}
         self.names = set()
@@ -94,6 +100,7 @@ class Containers:
         """Starts `argv` in a container of the image (the gateway's entrypoint unless `entrypoint`)."""
         name = self.container(label)
         command = [*self.engine, "run", "--rm", "--name", name, "--network", "host", "--ipc", "host",
+                   "-e", f"RSG_METRICS_PORT={self.metrics_port}",
                    "-v", f"{self.data}:{DATA}", *[arg for mount in mounts for arg in ("-v", mount)]]
         if entrypoint:
             command += ["--entrypoint", entrypoint]
@@ -116,7 +123,7 @@ class Containers:
         name = self.container(label)
         self.names.add(name)
         self.engine_run("run", "-d", "--name", name, "--restart", "on-failure", "--network", "host", "--ipc", "host",
-                        "-v", f"{self.stats_dir}:{STATS_DIR}", self.image, *map(str, self.gateway_args(port)))
+                        "-e", f"RSG_METRICS_PORT={self.metrics_port}", "-v", f"{self.stats_dir}:{STATS_DIR}", self.image, *map(str, self.gateway_args(port)))
         return name
 
     def inspect(self, name, template):
@@ -228,9 +235,6 @@ def pipeline(c):
     stats = wait_for_stats(c.stats, lambda s: s["frames_published"] >= COUNT, "the gateway to publish every frame")
     check((stats["frames_received"], stats["lost"], sum(stats["invalid"].values())) == (COUNT, 0, 0),
           f"gateway counters: {stats}")
-    # Docker runs the check itself, the first one after the start period (10 s).
-    wait_for(lambda: healthy(c, c.container("gateway")), "the image's HEALTHCHECK to pass on the gateway",
-             timeout_s=60, interval_s=1)
 
     time.sleep(1.5)  # the last samples and a status sample reach the recorder
     check(c.stop("record") == 0, f"rsg_record did not exit 0 on SIGTERM: {c.stderr('record')}")
@@ -239,12 +243,28 @@ def pipeline(c):
     check(seen["states"] == COUNT and seen["statuses"] >= 1, f"the reference reader read {seen}")
     print(f"[image] pipeline: {COUNT} frames exact at rsg_echo and in the MCAP file ({seen})", flush=True)
 
-    # The HEALTHCHECK can fail: a gateway that keeps no stats file (the entrypoint replaced) is
-    # unhealthy (checked with podman, which runs the check at once; Docker says so after 3 checks).
-    c.start("nostats", "--listen", f"127.0.0.1:{free_udp_port()}", "--domain", c.domain, entrypoint="rsg_gateway")
-    wait_for(lambda: "ingress: frames on UDP" in c.stderr("nostats"), "the second gateway to start")
-    check(c.name != "podman" or not healthy(c, c.container("nostats")),
-          "the HEALTHCHECK passes on a gateway that writes no stats file")
+
+def health(c):
+    """The HEALTHCHECK follows /healthz: no robot yet, streaming, stopped. With podman each check is
+    run on demand (`podman healthcheck run`); Docker runs it every 10 s and says unhealthy after 3
+    failures, so there the waits are longer but the states the same."""
+    port = free_udp_port()
+    c.gateway(port)
+    wait_for_stats(c.stats, lambda s: True, "the gateway container to start", timeout_s=60)
+    gateway = c.container("gateway")
+    check(c.name != "podman" or not healthy(c, gateway), "healthy before the robot sent a frame")
+    c.start("sim", "--to", f"127.0.0.1:{port}", "--rate", "500", "--duration", "120", entrypoint="rsg_sim")
+    wait_for_stats(c.stats, lambda s: s["frames_published"] > 0, "the gateway to publish", timeout_s=60)
+    wait_for(lambda: healthy(c, gateway), "the HEALTHCHECK to pass while rsg_sim streams", timeout_s=60, interval_s=1)
+    check(c.stop("sim") == 0, f"rsg_sim did not exit 0 on SIGTERM: {c.stderr('sim')}")
+    wait_for(lambda: not healthy(c, gateway), "the HEALTHCHECK to fail once the frames stopped", timeout_s=60,
+             interval_s=1)
+    # A container of another tool runs no gateway: healthy.
+    c.start("echo", "--domain", c.domain, entrypoint="rsg_echo")
+    wait_for(lambda: healthy(c, c.container("echo")), "the HEALTHCHECK to pass in a container without a gateway",
+             timeout_s=60, interval_s=1)
+    print("[image] health: unhealthy before the robot, healthy while it streams, unhealthy after it stopped; "
+          "healthy without a gateway", flush=True)
 
 
 def view_and_restart(c):
@@ -341,7 +361,8 @@ def view_and_restart(c):
 
 # What the compose runner below understands of a service; any other key fails the test, so that
 # compose.yaml cannot grow a setting this test would silently leave out.
-COMPOSE_KEYS = {"image", "build", "network_mode", "ipc", "entrypoint", "command", "volumes", "restart", "depends_on"}
+COMPOSE_KEYS = {"image", "build", "network_mode", "ipc", "entrypoint", "command", "volumes", "restart", "depends_on",
+                "environment"}
 
 
 def compose_services(path, env):
@@ -377,6 +398,8 @@ def compose_up(c, project, env):
         for key, flag in (("network_mode", "--network"), ("ipc", "--ipc"), ("restart", "--restart")):
             if key in service:
                 args += [flag, service[key]]
+        for variable in service.get("environment", []):
+            args += ["-e", variable]
         for volume in service.get("volumes", []):
             source, target = volume.split(":", 1)
             args += ["-v", f"{project}_{source}:{target}" if source in volumes else volume]
@@ -392,7 +415,7 @@ def compose(c):
     `docker compose` when the engine is Docker, else with compose_up."""
     project = c.prefix
     env = {**os.environ, "RSG_IMAGE": c.image, "RSG_DOMAIN": str(c.domain), "RSG_ROBOT_PORT": str(free_udp_port()),
-           "RSG_VIEW_PORT": str(free_tcp_port())}
+           "RSG_VIEW_PORT": str(free_tcp_port()), "RSG_METRICS_PORT": str(c.metrics_port)}
     docker_compose = ["docker", "compose", "-p", project, "-f", str(ROOT / "docker" / "compose.yaml")]
 
     def logs(service):
@@ -464,7 +487,7 @@ def ros2_type_hash(c):
     print(f"[image] ros2_type_hash: rosidl's hash on all {len(topics)} ROS 2 writers of the image's gateway", flush=True)
 
 
-CASES = {"pipeline": pipeline, "view_and_restart": view_and_restart, "compose": compose,
+CASES = {"pipeline": pipeline, "health": health, "view_and_restart": view_and_restart, "compose": compose,
          "ros2_type_hash": ros2_type_hash}
 
 

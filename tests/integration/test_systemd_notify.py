@@ -6,9 +6,12 @@ stops while the gateway is frozen with SIGSTOP, resumes on SIGCONT, and stops ag
 main loop is stuck and every other thread runs (Fast DDS's, the metrics server's, which then answers
 /healthz 503 "stale"): no timer thread pings for a stuck gateway. STOPPING=1 comes on SIGTERM.
 
-The loop is made to hang as a full disk or a hung NFS mount would: its next write of the stats
-file opens a FIFO that no one reads."""
+A disk that hangs (a full disk, a hung NFS mount: here the stats file's next write opens a FIFO
+that no one reads) does not stop the main loop: the stats file has a writer thread of its own, and
+WATCHDOG=1 keeps arriving. The main loop alone is stuck the way a debugger stops one thread:
+ptrace (PTRACE_SEIZE + PTRACE_INTERRUPT) on the thread that runs it, the process's main thread."""
 
+import ctypes
 import os
 import signal
 import socket
@@ -51,6 +54,29 @@ class NotifySocket(threading.Thread):
         self.socket.close()
 
 
+_libc = ctypes.CDLL(None, use_errno=True)
+_libc.ptrace.argtypes = [ctypes.c_long, ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p]
+PTRACE_DETACH, PTRACE_SEIZE, PTRACE_INTERRUPT = 17, 0x4206, 0x4207
+WALL = 0x40000000
+
+
+def ptrace(request, tid):
+    if _libc.ptrace(request, tid, None, None) != 0:
+        error = ctypes.get_errno()
+        raise OSError(error, f"ptrace({request:#x}, {tid}): {os.strerror(error)}")
+
+
+def freeze_thread(tid):
+    """Stops the one thread `tid` (the other threads of its process run on) until thaw_thread()."""
+    ptrace(PTRACE_SEIZE, tid)
+    ptrace(PTRACE_INTERRUPT, tid)
+    os.waitpid(tid, WALL)  # until it is stopped
+
+
+def thaw_thread(tid):
+    ptrace(PTRACE_DETACH, tid)
+
+
 def body(h):
     notify = NotifySocket(h.dir / "notify")
     notify.start()
@@ -91,7 +117,7 @@ def body(h):
     resumed = time.monotonic()
     wait_for(lambda: notify.since(resumed, "WATCHDOG=1"), "WATCHDOG=1 again after SIGCONT")
 
-    # Only the main loop stuck: its next stats file write blocks on a FIFO.
+    # A hung disk: the stats file's next write blocks on a FIFO; the main loop goes on.
     partial = Path(str(stats) + ".partial")
 
     def plant_fifo():
@@ -101,19 +127,15 @@ def body(h):
         except FileExistsError:  # the gateway is writing it right now
             return False
     wait_for(plant_fifo, "a FIFO in place of the stats file's next write")
-    time.sleep(1.5)  # the loop reaches its next status period (1 s) and blocks in open()
-    stuck = time.monotonic()
+    time.sleep(1.5)  # the writer thread reaches its next write (1 s) and blocks in open()
+    blocked = time.monotonic()
     time.sleep(3 * WATCHDOG_USEC / 1e6)
-    pings_while_stuck = notify.since(stuck, "WATCHDOG=1")
-    health = http_get(metrics, "/healthz")
-    reader = os.open(partial, os.O_RDONLY | os.O_NONBLOCK)  # unblocks the loop
+    pings_while_disk_hangs = notify.since(blocked, "WATCHDOG=1")
+    reader = os.open(partial, os.O_RDONLY | os.O_NONBLOCK)  # unblocks the writer thread
     try:
-        check(not pings_while_stuck,
-              f"{len(pings_while_stuck)} WATCHDOG=1 while the main loop was stuck: pinged from another thread")
-        check(health is not None and health[0] == 503 and health[1].startswith("stale"),
-              f"/healthz while the loop was stuck: {health}")
-        # Read until the loop has written and closed (closing earlier would SIGPIPE it).
-        written = []
+        check(len(pings_while_disk_hangs) >= 4,
+              f"{len(pings_while_disk_hangs)} WATCHDOG=1 while the stats file's disk hung: the main loop waited on it")
+        written = []  # read until the writer has written and closed (closing earlier would SIGPIPE it)
 
         def drained():
             try:
@@ -122,11 +144,26 @@ def body(h):
                 return False
             written.append(chunk)
             return len(written) > 1 and not chunk and any(written)
-        wait_for(drained, "the loop to write its stats into the FIFO")
-        unstuck = time.monotonic()
-        wait_for(lambda: notify.since(unstuck, "WATCHDOG=1"), "WATCHDOG=1 again once the loop runs")
+        wait_for(drained, "the writer thread to write its stats into the FIFO")
     finally:
         os.close(reader)
+    wait_for(lambda: not partial.exists() or not partial.is_fifo(), "the FIFO to be renamed away")
+
+    # Only the main loop stuck.
+    freeze_thread(gateway.pid)
+    try:
+        stuck = time.monotonic() + 0.2  # a ping already on its way may still arrive
+        time.sleep(3 * WATCHDOG_USEC / 1e6)
+        pings_while_stuck = notify.since(stuck, "WATCHDOG=1")
+        health = http_get(metrics, "/healthz")
+    finally:
+        thaw_thread(gateway.pid)
+    check(not pings_while_stuck,
+          f"{len(pings_while_stuck)} WATCHDOG=1 while the main loop was stuck: pinged from another thread")
+    check(health is not None and health[0] == 503 and health[1].startswith("stale"),
+          f"/healthz while the loop was stuck: {health}")
+    unstuck = time.monotonic()
+    wait_for(lambda: notify.since(unstuck, "WATCHDOG=1"), "WATCHDOG=1 again once the loop runs")
 
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
     check(notify.since(0, "STOPPING=1"), "no STOPPING=1 on SIGTERM")

@@ -18,7 +18,7 @@ grep -q 'docker/packages/' Makefile || fail "make deps does not read docker/pack
 
 # Every listed package is a real, installed Debian package (make deps ran before the tests).
 missing=()
-for list in docker/packages/{build,run,test}.txt; do
+for list in docker/packages/{build,run,test,package}.txt; do
   while read -r package; do
     [[ -z "$package" || "$package" == \#* ]] && continue
     dpkg-query -W -f='${Status}\n' "$package" 2>/dev/null | grep -q 'install ok installed' || missing+=("$package")

@@ -1,0 +1,47 @@
+#include "rsg/wire/frame_codec.hpp"
+
+#include "crc32_copy.hpp"
+#include "frame_checks.hpp"
+#include "rsg/wire/crc32.hpp"
+
+namespace rsg::wire {
+
+FrameCodec::FrameCodec(const FieldLayout& layout) noexcept
+    : layout_(&layout), plan_(Selection{}, layout), plan_key_(detail::selection_key(Selection{})) {}
+
+const ChunkedCopyPlan& FrameCodec::plan_for(const Selection& selection, std::uint64_t key) noexcept {
+  if (key != plan_key_) replan(selection, key);
+  return plan_;
+}
+
+// Out of line: the plan under construction takes kilobytes of stack, which the per-frame path
+// should not have to set up.
+[[gnu::noinline]] void FrameCodec::replan(const Selection& selection, std::uint64_t key) noexcept {
+  plan_ = ChunkedCopyPlan(selection, *layout_);
+  plan_key_ = key;
+}
+
+DecodeResult FrameCodec::decode(std::span<const std::uint8_t> bytes, void* base) noexcept {
+  return detail::FrameDecoder::decode(
+      bytes, [&](std::span<const std::uint8_t> covered, const Selection* selection) {
+        if (selection == nullptr) return crc32(covered);
+        const ChunkedCopyPlan& plan = plan_for(*selection, detail::selection_key(covered));
+        detail::zero_fills(plan.plan(), base);
+        return detail::crc32_scatter(covered, plan, static_cast<std::byte*>(base));
+      });
+}
+
+EncodeResult FrameCodec::encode(std::uint8_t packet_number, const Selection& selection, const void* base,
+                                std::span<std::uint8_t> out) noexcept {
+  EncodeResult result;
+  const std::size_t covered =
+      detail::begin_encode(packet_number, selection, base, *layout_, out, result.error);
+  if (covered == 0) return result;
+  const std::uint32_t crc =
+      detail::gather_crc32(out.first(covered), plan_for(selection, detail::selection_key(selection)),
+                           static_cast<const std::byte*>(base));
+  result.size = detail::finish_encode(out, covered, crc);
+  return result;
+}
+
+}  // namespace rsg::wire
