@@ -6,7 +6,8 @@ GatewayStatus, and the standard sensor_msgs/JointState, tf2_msgs/TFMessage and
 geometry_msgs/WrenchStamped (rosidl's type descriptions of the ROS 2 Kilted wheels and of make deps'
 tf2_msgs build). Needs make deps' ROS 2 environment; fails saying so without it.
 
-RSG_TYPE_HASHES_HEADER names the header the build generated (CMake sets it).
+RSG_TYPE_HASHES_HEADER names the header the build generated (CMake sets it). docs/ros2.md's table of
+the hashes must list the same.
 """
 import os
 import re
@@ -46,6 +47,11 @@ def body(h):
         check(ours[name] == theirs[name], f"{name}: rsg computes {ours[name]}, rosidl {theirs[name]} "
               "(ros2/type_hashes.py or ros2/standard_msgs disagrees with REP 2011 as rosidl implements it)")
         print(f"[type_hashes_match_rosidl] {name} {ours[name]}: rosidl agrees")
+    # docs/ros2.md's table of today's hashes is checked too, not trusted.
+    documented = dict(re.findall(r"^\| `([\w/]+)` \| `(RIHS01_[0-9a-f]{64})` \|$",
+                                 (REPO / "docs/ros2.md").read_text(), re.MULTILINE))
+    check(documented == ours, f"docs/ros2.md's table of type hashes {documented} is not the build's {ours}: "
+          "copy the build's (generated/rsg_ros2_type_hashes.hpp) into it")
 
 
 if __name__ == "__main__":
