@@ -4,6 +4,9 @@ BUILD      ?= build
 ASAN_BUILD ?= build-asan
 FUZZ_BUILD ?= build-fuzz
 JOBS       ?= $(shell nproc)
+# Tests side by side: each test that opens DDS holds a domain of its own (tests/support/test_domain.py),
+# and those that must run alone are RUN_SERIAL (CONTRIBUTING.md, Tests).
+CTEST_JOBS ?= $(JOBS)
 FUZZ_SECONDS ?= 30
 # Fast DDS 2.9.1 deletes an RTPSReader through the wrong type in its own destructor
 # (~RTPSReader, 64 vs 56 bytes); that report is about the library, not about rsg.
@@ -25,7 +28,7 @@ SHELL      := /bin/bash
 .SHELLFLAGS := -o pipefail -c
 
 
-.PHONY: all deps deps-run build build-demo install test unit-asan fuzz fuzz-build demo bench format clean wireshark-plugin
+.PHONY: all deps deps-run build build-demo install test test-long unit-asan fuzz fuzz-build demo bench format clean wireshark-plugin
 
 all: build
 
@@ -70,23 +73,29 @@ install: build
 unit-asan: deps
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DRSG_SANITIZE=ON $(CMAKE_COMMON)
 	cmake --build $(ASAN_BUILD) -j $(JOBS) --target unit_tests
-	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) ctest --output-on-failure -L unit 2>&1 | tee ctest.log
+	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) ctest --output-on-failure -j $(CTEST_JOBS) -L unit 2>&1 | tee ctest.log
 
 fuzz-build: deps
 	CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_BUILD) -DRSG_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_COMMON)
 	cmake --build $(FUZZ_BUILD) -j $(JOBS)
 
-# Each fuzzer for FUZZ_SECONDS (make fuzz FUZZ_SECONDS=600 for a long run).
+# Each fuzzer for FUZZ_SECONDS, JOBS at a time (make fuzz FUZZ_SECONDS=600 for a long run).
 fuzz: fuzz-build
-	FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD) 2>&1 | tee $(FUZZ_BUILD)/fuzz.log
+	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_JOBS=$(JOBS) tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD) 2>&1 | tee $(FUZZ_BUILD)/fuzz.log
 
-# Everything: all tests, the unit tests again under ASan+UBSan, every fuzzer for 20 s (keeps
-# `make test` under 20 minutes on 2 cores; `make fuzz FUZZ_SECONDS=600` for a long run).
+# What a contributor runs: every ctest test but those labelled long, side by side; the unit tests
+# again under ASan+UBSan; every fuzzer for 20 s (docs/development.md has the time each part takes).
 test: build
-	cd $(BUILD) && ctest --output-on-failure -j 1 2>&1 | tee ctest.log
+	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -LE long 2>&1 | tee ctest.log
 	$(MAKE) unit-asan
 	$(MAKE) fuzz FUZZ_SECONDS=20
 	@tests/summarize.sh $(BUILD)/ctest.log $(ASAN_BUILD)/ctest.log -- $(FUZZ_BUILD)/fuzz.log
+
+# The long scenarios (ctest label long: network namespaces, reliability under load, churn and
+# scale), most of them RUN_SERIAL; .ci/run runs it after make test.
+test-long: build
+	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -L long 2>&1 | tee ctest-long.log
+	@tests/summarize.sh $(BUILD)/ctest-long.log --
 
 # Only what the demo runs, with only the build and run packages, optimised without debug info and
 # without configuring the tests (a third less compiling than in $(BUILD)): a fresh machine shows

@@ -8,9 +8,10 @@ set -euo pipefail
 
 bin=${1:?usage: demo.sh BIN_DIR [SECONDS]}
 seconds=${2:-${RSG_DEMO_SECONDS:-10}}
-# A domain and port of its own, so a demo never talks to another demo or a test on this machine.
+# A domain and port of its own, so a demo never talks to another demo or a test on this machine
+# (the tests' domains are 20-99, their DDS ports below 32768: tests/support/test_domain.py).
 domain=${RSG_DEMO_DOMAIN:-$(($$ % 100 + 120))}
-port=${RSG_DEMO_PORT:-$((20000 + $$ % 20000))}
+port=${RSG_DEMO_PORT:-$((40000 + $$ % 20000))}
 # rsg_view's usual port for people; the non-interactive check takes one next to the gateway's.
 view_port=${RSG_DEMO_VIEW_PORT:-$([[ -n "${RSG_DEMO_CHECK:-}" ]] && echo $((port + 1)) || echo 8765)}
 

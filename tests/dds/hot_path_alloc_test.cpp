@@ -21,6 +21,7 @@
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/wire/frame.hpp"
+#include "test_domain.hpp"
 
 namespace rsg {
 namespace fdds = eprosima::fastdds::dds;
@@ -62,7 +63,7 @@ void expect_no_allocations_while_publishing(const std::string& profile, bool rea
   // A reader in a second participant and no intra-process shortcut, so the measured writes really
   // reach another participant through a transport or data-sharing.
   rsg::dds::disable_intraprocess_delivery();
-  const int domain = static_cast<int>(::getpid() % 200 + 10);
+  const int domain = rsg::test::test_domain();
   dds::load_profiles(std::filesystem::path(RSG_TEST_DATA_DIR) / "hot_path_profiles.xml");
   dds::Participant publishing(domain, profile);
   dds::Participant subscribing(domain, profile);

@@ -17,6 +17,7 @@
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
+#include "test_domain.hpp"
 
 namespace rsg {
 namespace fdds = eprosima::fastdds::dds;
@@ -30,7 +31,7 @@ class Views : public ::testing::Test {
     dds::load_profiles(std::filesystem::path(RSG_VIEWS_TEST_DIR) / "broken_views.xml");
   }
 
-  static int test_domain() { return static_cast<int>(::getpid() % 200 + 10); }
+  static int test_domain() { return rsg::test::test_domain(); }
 };
 
 TEST_F(Views, GroupFilterExpressionIsTheDocumentedDdsSql) {

@@ -25,6 +25,7 @@
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/dds/views.hpp"
 #include "sent_data_recorder.hpp"
+#include "test_domain.hpp"
 
 namespace rsg {
 namespace fdds = eprosima::fastdds::dds;
@@ -59,7 +60,7 @@ Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qo
                                        WriterKnowsGroupFilter knows = WriterKnowsGroupFilter::kYes) {
   dds::disable_intraprocess_delivery();
   dds::load_profiles(dds::default_profiles_dir());
-  const int domain = static_cast<int>(::getpid() % 200 + 10);
+  const int domain = rsg::test::test_domain();
 
   auto sent = std::make_shared<test::SentSamples>();
   auto publishing =
@@ -155,7 +156,7 @@ TEST(WriterSideFiltering, AWriterWithoutTheGroupFilterClassSendsEverything) {
 TEST(WriterSideFiltering, TheGatewayWriterLeavesFilteringToTheReaders) {
   dds::disable_intraprocess_delivery();  // before `any`: Fast DDS 3 ignores it after a participant
   dds::load_profiles(dds::default_profiles_dir());
-  dds::Participant any(static_cast<int>(::getpid() % 200 + 10), "");
+  dds::Participant any(rsg::test::test_domain(), "");
   fdds::DataWriterQos gateway_qos;
   ASSERT_EQ(any.publisher()->get_datawriter_qos_from_profile("rsg_state_writer", gateway_qos), rsg::dds::kOk);
   dds::leave_filtering_to_readers(gateway_qos);

@@ -20,6 +20,7 @@
 #include "random_state.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
+#include "test_domain.hpp"
 
 namespace rsg {
 namespace fdds = eprosima::fastdds::dds;
@@ -58,7 +59,7 @@ class EmbeddedGatewayTest : public ::testing::Test {
     // The reader must get its samples over the network, as a reader in another process would.
     rsg::dds::disable_intraprocess_delivery();
   }
-  const int domain_ = static_cast<int>(::getpid() % 200 + 10);
+  const int domain_ = rsg::test::test_domain();
 };
 
 TEST_F(EmbeddedGatewayTest, CallbackSeesExactlyWhatARemoteReaderReceives) {

@@ -35,6 +35,7 @@
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/ros2.hpp"
 #include "rsg/wire/frame.hpp"
+#include "test_domain.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;
@@ -216,7 +217,7 @@ class IngressAllocation : public ::testing::Test {
   std::string topic_ = "ingress_alloc";
   std::string type_name_;  // empty: rsg's own
   std::vector<Ingress::Options::RateTopic> rate_topics_;
-  const int domain_ = static_cast<int>(::getpid() % 200 + 10);
+  const int domain_ = rsg::test::test_domain();
   dds::Participant publishing_{domain_, "rsg_hot_path_udp"};
   dds::Participant subscribing_{domain_, "rsg_hot_path_udp"};
 };

@@ -24,6 +24,8 @@
 #include <thread>
 #include <vector>
 
+#include "test_domain.hpp"
+
 namespace rsg::gateway {
 namespace {
 
@@ -256,7 +258,7 @@ class GatewayProcess {
 };
 
 std::vector<std::string> gateway_flags(const std::string& cpu) {
-  const int domain = static_cast<int>(::getpid() % 100 + 110);
+  const int domain = rsg::test::test_domain();
   return {"--listen",
           "127.0.0.1:0",
           "--domain",

@@ -1,7 +1,9 @@
 """Shared plumbing of the multi-process tests: binaries, ports, DDS domains, child processes.
 
-Every test gets its own DDS domain and its own UDP ports, so tests never see each other's
-traffic; every child process is killed when the test ends, passed or not; every wait is bounded.
+Every test gets its own DDS domain (tests/support/test_domain.py: held by a lock while the test runs,
+so tests run side by side by `ctest -j` never share one) and its own UDP ports, so tests never see
+each other's traffic; every child process is killed when the test ends, passed or not; every wait is
+bounded.
 """
 
 import argparse
@@ -17,6 +19,9 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "support"))
+from test_domain import acquire_domain, test_domain  # noqa: E402,F401  (re-exported to the tests)
 
 # Generous on purpose: a 2-core machine shared with builds makes discovery and start-up slow.
 DEFAULT_WAIT_S = 20.0
@@ -75,11 +80,6 @@ def port_is_free(port):
             return True
         except OSError:
             return False
-
-
-def test_domain():
-    """A DDS domain of this test alone (ctest runs tests as separate processes)."""
-    return os.getpid() % 200 + 10
 
 
 def read_json(path):

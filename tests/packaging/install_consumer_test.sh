@@ -39,5 +39,6 @@ cmake --build "$work/build_core" > "$work/build_core.log" 2>&1 || { cat "$work/b
 # A view, with the installed profiles, on a domain of its own (Fast DDS 2 or 3: what rsg was built on).
 "$work/build/view_consumer" "$work/prefix/share/rsg/xml_profiles" $(($$ % 200 + 10))
 # The embedded gateway from the installed package, with the installed profiles, on its own domain.
-"$work/build/embedded_consumer" "$work/prefix/share/rsg/xml_profiles" $(($$ % 200 + 10))
+"$work/build/embedded_consumer" "$work/prefix/share/rsg/xml_profiles" \
+  "${RSG_TEST_DOMAIN:?run it through tests/support/test_domain.py, which takes a domain}"
 echo "install_consumer: OK ($(echo "$installed" | wc -w) public headers)"

@@ -19,7 +19,6 @@ Standard library only.
 import argparse
 import contextlib
 import json
-import os
 import re
 import socket
 import struct
@@ -29,8 +28,10 @@ import tempfile
 import threading
 import time
 import unittest
-import zlib
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "support"))
+from test_domain import acquire_domain  # noqa: E402
 
 ARGS = None  # the command line, set once by main()
 
@@ -266,9 +267,9 @@ def forge_permissions(pki, forged):
 
 class Security(unittest.TestCase):
     def setUp(self):
-        # A domain of its own, so that ctest may run the tests in parallel; distinct per test so
-        # that running them all in one process does not reuse a domain either.
-        self.domain = (os.getpid() + zlib.crc32(self.id().encode())) % 200 + 10
+        # A domain of its own (tests/support/test_domain.py), so that ctest may run the tests in
+        # parallel; a new one per test, so that running them all in one process reuses none either.
+        self.domain = acquire_domain()
         Path(ARGS.work_dir).mkdir(parents=True, exist_ok=True)
         self.work = Path(self.enterContext(tempfile.TemporaryDirectory(
             dir=ARGS.work_dir, prefix=f"{self._testMethodName}-")))

@@ -6,7 +6,7 @@
 //   rsg_bench_e2e --smoke             a few hundred frames through the gateway: do they arrive?
 //   rsg_bench_e2e --role writer ...   (internal) the writer process of the plain Fast DDS baseline
 //
-// Every run has its own DDS domain (pid % 200 + 10), ports the kernel picks, and a scratch
+// Every run has its own DDS domain (tests/support/test_domain.hpp), ports the kernel picks, and a scratch
 // directory for the children's logs (kept, and named, when the run fails).
 #include <sys/prctl.h>
 #include <unistd.h>
@@ -22,6 +22,7 @@
 #include "dds/internal/fastdds_compat.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "scenarios.hpp"
+#include "test_domain.hpp"
 
 namespace {
 
@@ -179,7 +180,7 @@ std::filesystem::path own_directory() {
 
 int main(int argc, char** argv) {
   BenchOptions options;
-  options.domain = static_cast<int>(::getpid() % 200 + 10);
+  options.domain = rsg::test::test_domain();
   options.bin_dir = own_directory();
   options.profiles_dir = rsg::dds::default_profiles_dir();
   std::filesystem::path bench_profiles = RSG_BENCH_PROFILES;
