@@ -15,10 +15,14 @@ port=${RSG_DEMO_PORT:-$((40000 + $$ % 20000))}
 # rsg_view's usual port for people; the non-interactive check takes one next to the gateway's.
 view_port=${RSG_DEMO_VIEW_PORT:-$([[ -n "${RSG_DEMO_CHECK:-}" ]] && echo $((port + 1)) || echo 8765)}
 
+# rsg_view's messages: shown when the non-interactive check fails, else not at all.
+view_log=/dev/null
+[[ -n "${RSG_DEMO_CHECK:-}" ]] && view_log=$(mktemp)
 pids=()
 cleanup() {
   for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
   wait 2>/dev/null || true
+  [[ $view_log == /dev/null ]] || rm -f "$view_log"
 }
 trap cleanup EXIT
 trap 'exit 0' INT TERM
@@ -26,7 +30,7 @@ trap 'exit 0' INT TERM
 echo "rsg demo: rsg_sim -> udp://127.0.0.1:$port -> rsg_gateway -> DDS domain $domain -> rsg_echo, ${seconds} s"
 "$bin/rsg_gateway" --listen "127.0.0.1:$port" --domain "$domain" --log-level warn &
 pids+=($!)
-"$bin/rsg_view" --domain "$domain" --listen "127.0.0.1:$view_port" 2>/dev/null &
+"$bin/rsg_view" --domain "$domain" --listen "127.0.0.1:$view_port" 2>"$view_log" &
 pids+=($!)
 
 # The page's HTML from rsg_view, fetched with bash alone (no curl on a minimal Debian).
@@ -46,7 +50,8 @@ if [[ -n "${RSG_DEMO_CHECK:-}" ]]; then
   "$bin/rsg_echo" --domain "$domain" --view view_kinematics --json --count 100 --timeout "$seconds" > /dev/null
   echo "rsg demo: OK, 100 samples received"
   for _ in $(seq 50); do page_served 2>/dev/null && { echo "rsg demo: OK, rsg_view serves the page"; exit 0; }; sleep 0.2; done
-  echo "rsg demo: rsg_view did not serve its page on 127.0.0.1:$view_port" >&2
+  echo "rsg demo: rsg_view did not serve its page on 127.0.0.1:$view_port; it said:" >&2
+  cat "$view_log" >&2
   exit 1
 fi
 

@@ -14,14 +14,17 @@ never one a DDS participant of another test binds, and ROS 2's valid domain ids 
 
 As a command, for tests that are shell scripts:
 
-    test_domain.py [--env NAME] -- COMMAND [ARG...]
+    test_domain.py [--env NAME] [--port-env NAME]... -- COMMAND [ARG...]
 
 takes a domain, puts it into the environment as NAME (default RSG_TEST_DOMAIN) and execs COMMAND,
-which inherits the locked file and so holds the domain until it and its children exit.
+which inherits the locked file and so holds the domain until it and its children exit; each
+--port-env NAME puts there a port the kernel picked, free for UDP and TCP on 127.0.0.1 (a fixed
+or pid-derived port may be one another test holds).
 """
 import argparse
 import fcntl
 import os
+import socket
 import sys
 
 LOCK_DIR = os.environ.get("RSG_TEST_LOCK_DIR", "/tmp/rsg-test-domains")
@@ -58,9 +61,24 @@ def test_domain():
     return next(iter(_held)) if _held else acquire_domain()
 
 
+def free_port():
+    """A port the kernel picked (port 0) that is free for both UDP and TCP on 127.0.0.1 right now."""
+    while True:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as udp:
+            udp.bind(("127.0.0.1", 0))
+            port = udp.getsockname()[1]
+            with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as tcp:
+                try:
+                    tcp.bind(("127.0.0.1", port))
+                    return port
+                except OSError:
+                    continue
+
+
 def main():
     parser = argparse.ArgumentParser(description="Runs COMMAND with a DDS domain of its own in the environment.")
     parser.add_argument("--env", default="RSG_TEST_DOMAIN", help="the variable that names the domain")
+    parser.add_argument("--port-env", action="append", default=[], help="a variable to set to a free port")
     parser.add_argument("command", nargs=argparse.REMAINDER)
     args = parser.parse_args()
     command = args.command[1:] if args.command[:1] == ["--"] else args.command
@@ -68,6 +86,8 @@ def main():
         parser.error("no COMMAND")
     domain = acquire_domain(inheritable=True)
     os.environ[args.env] = str(domain)
+    for name in args.port_env:
+        os.environ[name] = str(free_port())
     os.execvp(command[0], command)
 
 
