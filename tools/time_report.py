@@ -7,7 +7,8 @@
    cache off (CCACHE_DISABLE=1: the figures are what a fresh clone pays), builds everything and
    prints the N slowest translation units and targets from Ninja's own log (.ninja_log: start and
    end of every step, in ms), with the build's wall time and summed compile time.
-2. Runs ctest there (-j1, as make test does) and prints the N slowest tests and the total.
+2. Runs ctest there serially (-j1: each test's time is its own; make test runs them side by side, with
+   the long ones in make test-long) and prints the N slowest tests and the total.
 Both tables are Markdown, to paste into docs/development.md with the CPU that measured them
 (printed first).
 """
