@@ -79,7 +79,7 @@ class Containers:
         # The entrypoint's --metrics 127.0.0.1:$RSG_METRICS_PORT, where the HEALTHCHECK asks /healthz:
         # a port of this run (the host network is shared with every other test's gateways).
         self.metrics_port = free_tcp_port()
-        # Domains 210-230: none of ctest's (harness.test_domain: 10-209), one per case, so that no
+        # Domains 210-230: none of ctest's (tests/support/test_domain.py: 20-99), one per case, so that no
         # other test's gateway and no earlier case's writer is matched.
         self.domain = 210 + os.getpid() % 5 * 4 + sorted(CASES).index(case)
         self.prefix = f"rsg-image-test-{os.getpid()}-{case.replace('_', '-')}"

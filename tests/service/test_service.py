@@ -58,7 +58,7 @@ WATCHDOG_MARGIN_S = 10
 START_LIMIT_BURST = 5  # StartLimitBurst= of the unit
 FRAMES = 300
 RATE = 500
-# DDS domains no other suite uses: ctest's are 10-209 (harness.test_domain), make test-image's
+# DDS domains no other suite uses: ctest's are 20-99 (tests/support/test_domain.py), make test-image's
 # 210-230. A lock file per domain keeps two runs on this machine apart; the partition, random per
 # run, keeps any other participant's samples out.
 DOMAINS = (231, 232)
