@@ -4,6 +4,8 @@
 set -euo pipefail
 source_dir=${1:?usage: install_consumer_test.sh SOURCE_DIR BUILD_DIR}
 build_dir=${2:?usage: install_consumer_test.sh SOURCE_DIR BUILD_DIR}
+# The DDS domain of the consumers that open one: the one tests/support/test_domain.py holds for us.
+domain=${RSG_TEST_DOMAIN:?run it through tests/support/test_domain.py, which takes a domain}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
@@ -37,8 +39,7 @@ cmake -S "$source_dir/tests/packaging/consumer" -B "$work/build_core" -DCMAKE_PR
 cmake --build "$work/build_core" > "$work/build_core.log" 2>&1 || { cat "$work/build_core.log"; exit 1; }
 "$work/build/consumer"
 # A view, with the installed profiles, on a domain of its own (Fast DDS 2 or 3: what rsg was built on).
-"$work/build/view_consumer" "$work/prefix/share/rsg/xml_profiles" $(($$ % 200 + 10))
+"$work/build/view_consumer" "$work/prefix/share/rsg/xml_profiles" "$domain"
 # The embedded gateway from the installed package, with the installed profiles, on its own domain.
-"$work/build/embedded_consumer" "$work/prefix/share/rsg/xml_profiles" \
-  "${RSG_TEST_DOMAIN:?run it through tests/support/test_domain.py, which takes a domain}"
+"$work/build/embedded_consumer" "$work/prefix/share/rsg/xml_profiles" "$domain"
 echo "install_consumer: OK ($(echo "$installed" | wc -w) public headers)"
