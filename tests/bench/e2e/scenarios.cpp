@@ -154,6 +154,19 @@ json read_json_file(const std::filesystem::path& file) {
   return in ? json::parse(in, nullptr, /*allow_exceptions=*/false) : json();
 }
 
+/// Discovery is not symmetric: the reader seeing the writer does not mean the writer sees the
+/// reader, and frames published before it does are lost to that reader. Waits until the gateway's
+/// stats file counts `readers` readers of its RobotState writer.
+bool wait_for_state_readers(const std::filesystem::path& stats, int readers) {
+  const auto deadline = Clock::now() + kStartupTimeout;
+  while (Clock::now() < deadline) {
+    const json counters = read_json_file(stats);
+    if (counters.is_object() && counters.value("state_readers", 0) >= readers) return true;
+    std::this_thread::sleep_for(milliseconds(20));
+  }
+  return false;
+}
+
 /// Waits until `log` has a line containing `marker` and returns what follows the marker on it.
 std::string wait_for_log_line(const std::filesystem::path& log, std::string_view marker,
                               ChildProcess& process) {
@@ -194,6 +207,8 @@ class GatewayProcess {
 
   const transport::Endpoint& ingress() const { return ingress_; }
   pid_t pid() const { return process_.pid(); }
+  /// Its stats file (empty for a relay that writes none).
+  const std::filesystem::path& stats() const { return stats_; }
 
   /// Stops it and returns the counters of its final stats file.
   json stop() {
@@ -283,6 +298,7 @@ json run_gateway(const BenchOptions& options, const Transport& transport) {
   StateSubscriber subscriber(participant, topic, options.reader_profile_for(transport), log,
                              options.reader_waitset, &notified);
   require(subscriber.wait_for_writer(kStartupTimeout), "the gateway's writer never matched");
+  require(wait_for_state_readers(gateway.stats(), 1), "the gateway's writer never matched the reader");
 
   FrameSender send(gateway.ingress());
   send_paced(0, options.warmup_frames(), options.rate_hz, send);
@@ -344,8 +360,10 @@ json run_embedded(const BenchOptions& options) {
   for (const std::string& arg : options.gateway_args)
     if (const auto equals = arg.find('='); arg.starts_with("--") && equals != std::string::npos)
       more += arg.substr(2, equals - 2) + ": " + arg.substr(equals + 1) + "\n";
-  gateway::EmbeddedGateway gateway(more + "listen: 127.0.0.1:0\ndomain: " + std::to_string(options.domain) +
-                                       "\ntopic: " + topic + "\nstatus-topic: " + topic +
+  const std::filesystem::path stats = options.scratch_dir / (topic + "_stats.json");
+  gateway::EmbeddedGateway gateway(more + "listen: 127.0.0.1:0\nstats-file: " + stats.string() +
+                                       "\ndomain: " + std::to_string(options.domain) + "\ntopic: " + topic +
+                                       "\nstatus-topic: " + topic +
                                        "_status\nprofiles: " + options.profiles_dir.string() +
                                        "\nwriter-profile: " + options.writer_profile + "\n",
                                    [&](const RobotState& sample) {
@@ -357,6 +375,7 @@ json run_embedded(const BenchOptions& options) {
   dds::Participant participant(options.domain, std::string(udp.participant_profile));
   StateSubscriber subscriber(participant, topic, options.reader_profile_for(udp), reader_log);
   require(subscriber.wait_for_writer(kStartupTimeout), "the embedded gateway's writer never matched");
+  require(wait_for_state_readers(stats, 1), "the embedded gateway's writer never matched the reader");
 
   const transport::Endpoint to = gateway.local_endpoint();
   FrameSender send(to);
