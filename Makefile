@@ -134,7 +134,7 @@ format:
 	git ls-files '*.cpp' '*.hpp' '*.h' '*.c' | xargs clang-format -i
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) $(DEMO_BUILD) build-fdds3 build-time $(PKG_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) build-demo build-fdds3 build-time $(PKG_BUILD)
 
 # Fast DDS 3 (Debian 13's 3.1.2) in a cached trixie chroot, and across versions with $(BUILD)'s
 # 2.9.1 on the host (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/.
