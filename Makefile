@@ -54,10 +54,10 @@ deps: deps-run
 	@# Node and npm for the tests that read MCAP files with @mcap/core (Debian's, unless a node is there).
 	@command -v npm >/dev/null || { $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends nodejs npm; }
-	@[ tests/record/package-lock.json -ot tests/record/node_modules/.package-lock.json ] || \
-	  npm ci --prefix tests/record --no-audit --no-fund
-	@[ tests/rsg_view/package-lock.json -ot tests/rsg_view/node_modules/.package-lock.json ] || \
-	  npm ci --prefix tests/rsg_view --no-audit --no-fund
+	@[ tests/tools/record/package-lock.json -ot tests/tools/record/node_modules/.package-lock.json ] || \
+	  npm ci --prefix tests/tools/record --no-audit --no-fund
+	@[ tests/tools/view/package-lock.json -ot tests/tools/view/node_modules/.package-lock.json ] || \
+	  npm ci --prefix tests/tools/view --no-audit --no-fund
 	@for script in tools/deps/*.sh; do DEPS_DIR=$(DEPS_DIR) $$script || exit 1; done
 
 # The tests' build and the demo's are one tree with one set of flags: -O2 with line tables only

@@ -2,14 +2,14 @@
 over loopback and the host's /dev/shm (what docker/compose.yaml sets).
 
   pipeline      rsg_sim -> rsg_gateway -> rsg_echo --json and rsg_record: every frame exact at the
-                echo, the MCAP file read by the reference reader (tests/record/check_recording.mjs)
+                echo, the MCAP file read by the reference reader (tests/tools/record/check_recording.mjs)
                 to the values sent
   health        the image's HEALTHCHECK (GET /healthz on the gateway's metrics port): unhealthy
                 before the robot streams, healthy while rsg_sim streams, unhealthy again once it
                 stops; healthy in a container of another tool
   view_and_restart
                 rsg_view serves its page to Debian's headless Chromium on the host
-                (tests/rsg_view/check_page.mjs): live samples rsg_sim sent, plotted by Chart.js; then
+                (tests/tools/view/check_page.mjs): live samples rsg_sim sent, plotted by Chart.js; then
                 the gateway container killed (`ENGINE kill`) and run again, as `restart: on-failure`
                 would, then its process killed from the host (a crash, the Fast DDS 2.9.1 abort's
                 effect) and restarted by the engine itself: the running echo and recorder resume,
@@ -239,7 +239,7 @@ def pipeline(c):
     time.sleep(1.5)  # the last samples and a status sample reach the recorder
     check(c.stop("record") == 0, f"rsg_record did not exit 0 on SIGTERM: {c.stderr('record')}")
     check("dropped 0 (sequence gaps), 0 (lost in DDS)" in c.stderr("record"), c.stderr("record"))
-    seen = node("tests/record/check_recording.mjs", c.data / "pipeline.mcap", "--frames", c.data / "sim.jsonl")
+    seen = node("tests/tools/record/check_recording.mjs", c.data / "pipeline.mcap", "--frames", c.data / "sim.jsonl")
     check(seen["states"] == COUNT and seen["statuses"] >= 1, f"the reference reader read {seen}")
     print(f"[image] pipeline: {COUNT} frames exact at rsg_echo and in the MCAP file ({seen})", flush=True)
 
@@ -295,7 +295,7 @@ def view_and_restart(c):
                                 f"--user-data-dir={c.dir / 'chromium'}", f"--remote-debugging-port={devtools}",
                                 "about:blank"], stdout=subprocess.DEVNULL, stderr=open(c.dir / "chromium.err", "wb"))
     try:
-        shown = node("tests/rsg_view/check_page.mjs", devtools, f"http://127.0.0.1:{ws_port}/", c.dir / "rsg_view.png")
+        shown = node("tests/tools/view/check_page.mjs", devtools, f"http://127.0.0.1:{ws_port}/", c.dir / "rsg_view.png")
     finally:
         browser.kill()
         browser.wait()
@@ -351,7 +351,7 @@ def view_and_restart(c):
     sent = read_json_lines(c.data / "sim2.jsonl")
     check(len(received) >= crashed + 500, f"rsg_echo printed {len(received)} samples, {crashed} before the crash")
     check(is_subsequence(received, sent), "rsg_echo printed a sample rsg_sim did not send, or out of order")
-    seen = node("tests/record/check_recording.mjs", c.data / "restart.mcap")
+    seen = node("tests/tools/record/check_recording.mjs", c.data / "restart.mcap")
     check(seen["states"] >= 1000, f"the recording holds {seen['states']} states")
     print(f"[image] restart: {before} samples before the kill, {crashed} before the crash, {len(received)} in "
           f"all, every one sent by rsg_sim, in order; the recording is readable ({seen['states']} states)", flush=True)
@@ -441,7 +441,7 @@ def compose(c):
         volume = c.engine_run("volume", "inspect", "--format", "{{.Mountpoint}}", f"{project}_recordings").stdout.strip()
         files = sorted(Path(volume).glob("robot*.mcap"))
         check(files, f"no recording in the volume ({volume})")
-        seen = node("tests/record/check_recording.mjs", files[0])
+        seen = node("tests/tools/record/check_recording.mjs", files[0])
         check(seen["states"] >= 100, f"the recording in the volume holds {seen['states']} states")
         print(f"[image] compose: gateway healthy, echo printing, page at {url}, {files[0].name} in the volume "
               f"({seen['states']} states)", flush=True)

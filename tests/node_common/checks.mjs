@@ -1,4 +1,4 @@
-// What the Node checks of rsg share (tests/rsg_view, tests/record): failing with a reason, reading
+// What the Node checks of rsg share (tests/tools/view, tests/tools/record): failing with a reason, reading
 // the command line, reading rsg_sim's --record JSON lines, and comparing a decoded RobotState with
 // the frame rsg_sim sent. No npm package here: each test folder has its own node_modules.
 import { readFileSync } from "node:fs";

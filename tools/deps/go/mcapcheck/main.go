@@ -1,5 +1,5 @@
 // rsg-mcap-check: checks an MCAP file with MCAP's own Go library (github.com/foxglove/mcap/go/mcap,
-// the library the official `mcap` CLI is built on), for the tests in tests/record/. The official
+// the library the official `mcap` CLI is built on), for the tests in tests/tools/record/. The official
 // CLI itself (`mcap doctor`, `mcap info`) is not served by the Go module proxy (see
 // docs/mcap-tested.md), so this program applies the rules of the MCAP specification that `mcap
 // doctor` applies, and a few more, using the library's lexer and parsers for every byte it reads.

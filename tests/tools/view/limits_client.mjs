@@ -5,7 +5,7 @@
 //   node limits_client.mjs HOST:PORT
 import http from "node:http";
 import WebSocket from "ws";
-import { checks } from "../node_common/checks.mjs";
+import { checks } from "../../node_common/checks.mjs";
 
 const [hostPort] = process.argv.slice(2);
 const { fail } = checks("limits_client");

@@ -8,7 +8,7 @@
 //   node fair_client.mjs ws://HOST:PORT --stop FILE [--pause-ms PAUSE --read-ms READ]
 import { existsSync } from "node:fs";
 import WebSocket from "ws";
-import { checks, commandLine } from "../node_common/checks.mjs";
+import { checks, commandLine } from "../../node_common/checks.mjs";
 
 const { fail, check } = checks("fair_client");
 const { args, option } = commandLine();

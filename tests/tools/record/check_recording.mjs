@@ -24,7 +24,7 @@ import { MessageReader as Ros2MessageReader } from "@foxglove/rosmsg2-serializat
 import * as zstd from "@foxglove/wasm-zstd";
 import { readFileSync } from "node:fs";
 import { open } from "node:fs/promises";
-import { checkState, checks, commandLine, readFrames } from "../node_common/checks.mjs";
+import { checkState, checks, commandLine, readFrames } from "../../node_common/checks.mjs";
 
 const { check } = checks("check_recording");
 const { args, option, flag } = commandLine();

@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-ROOT = HERE.parents[1]
+ROOT = HERE.parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "integration"))
 from harness import (UdpRelay, check, free_udp_port, main, read_json_lines, receive_timed,  # noqa: E402
                      timed_receiver, wait_for, wait_for_stats, wait_matched)
@@ -30,7 +30,7 @@ def node_check(h, mcap, *args):
     node = shutil.which("node")
     check(node is not None, "node is not installed: run `make deps`")
     check((HERE / "node_modules" / "@mcap" / "core").is_dir(),
-          "tests/record/node_modules is missing: run `make deps` (npm ci --prefix tests/record)")
+          "tests/tools/record/node_modules is missing: run `make deps` (npm ci --prefix tests/tools/record)")
     result = subprocess.run([node, str(HERE / "check_recording.mjs"), str(mcap), *map(str, args)],
                             capture_output=True, text=True, timeout=60)
     print(f"[{h.name}] check_recording: {result.stdout.strip()} {result.stderr.strip()}", flush=True)

@@ -5,7 +5,7 @@
 //   node check_page.mjs DEVTOOLS_PORT http://HOST:PORT/ SCREENSHOT.png
 import { writeFileSync } from "node:fs";
 import WebSocket from "ws";
-import { checks } from "../node_common/checks.mjs";
+import { checks } from "../../node_common/checks.mjs";
 
 const [devtoolsPort, pageUrl, screenshotPath] = process.argv.slice(2);
 const { fail } = checks("check_page");

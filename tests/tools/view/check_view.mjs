@@ -27,7 +27,7 @@ import { parse as parseMsg } from "@foxglove/rosmsg";
 import { MessageReader as Ros2MessageReader } from "@foxglove/rosmsg2-serialization";
 import { readFileSync } from "node:fs";
 import WebSocket from "ws";
-import { checkState, checks, commandLine, waitForFrames } from "../node_common/checks.mjs";
+import { checkState, checks, commandLine, waitForFrames } from "../../node_common/checks.mjs";
 
 const { FoxgloveClient } = wsProtocol;
 const { fail, check } = checks("check_view");
@@ -122,7 +122,7 @@ function start() {
   const find = (schemaName, encoding) => channels.find((c) => c.schemaName === schemaName && c.schemaEncoding === encoding);
   const state = find("rsg::RobotState", "omgidl");
   check(state && state.encoding === "cdr", "no RobotState cdr+omgidl channel");
-  check(state.schema === readFileSync(new URL("../../idl/RobotState.idl", import.meta.url), "utf8"),
+  check(state.schema === readFileSync(new URL("../../../idl/RobotState.idl", import.meta.url), "utf8"),
         "the advertised schema is not idl/RobotState.idl");
   stateReader = new MessageReader("rsg::RobotState", parseIDL(state.schema));
   subscriptions.set(subscribe(state.id), "state");

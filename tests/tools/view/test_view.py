@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-ROOT = HERE.parents[1]
+ROOT = HERE.parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "integration"))
 from harness import check, free_udp_port, main, read_json_lines, wait_for, wait_for_stats, wait_reader_matched  # noqa: E402
 
@@ -35,11 +35,11 @@ def free_tcp_port():
 
 
 def node():
-    """Node and the packages of tests/rsg_view; fails the test (never skips) when they are missing."""
+    """Node and the packages of tests/tools/view; fails the test (never skips) when they are missing."""
     path = shutil.which("node")
     check(path is not None, "node is not installed: run `make deps`")
     check((HERE / "node_modules" / "@foxglove" / "ws-protocol").is_dir(),
-          "tests/rsg_view/node_modules is missing: run `make deps` (npm ci --prefix tests/rsg_view)")
+          "tests/tools/view/node_modules is missing: run `make deps` (npm ci --prefix tests/tools/view)")
     return path
 
 

@@ -4,7 +4,7 @@
 //
 //   node stall_client.mjs ws://HOST:PORT STALL_MS
 import WebSocket from "ws";
-import { checks } from "../node_common/checks.mjs";
+import { checks } from "../../node_common/checks.mjs";
 
 const [url, stallMs] = process.argv.slice(2);
 const { fail } = checks("stall_client");
