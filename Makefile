@@ -179,8 +179,7 @@ package: deps-run
 	lintian --fail-on error --info $(PKG_BUILD)/packages/rsg_*.deb
 
 # The package under a real systemd as PID 1 (tests/service/run.sh): installed with apt-get into a
-# clean Debian 12 container, the unit started, fed, killed, frozen, broken, upgraded and purged.
-# Needs podman, runc and debootstrap (test.txt), not the rest of make deps.
-test-service: package
-	$(call apt_install,test)
+# clean Debian 12 container, the unit started, fed, killed, frozen, upgraded, read by a real rclpy
+# node (make deps' ROS 2 environment: the type hashes), broken and purged.
+test-service: package deps
 	PKG_BUILD=$(PKG_BUILD) tests/service/run.sh

@@ -19,6 +19,8 @@ the ones before left:
                 the journal) within WatchdogSec (5 s) + WATCHDOG_MARGIN_S, and restarts it
   upgrade       apt-get install of the current .deb over the older one: the running instance is
                 restarted by postinst on the new version and frames arrive exact
+  ros2_type_hash  a second instance with --ros2 and the standard topics: a real rclpy node on the
+                host (make deps' ROS 2 environment) sees rosidl's RIHS01 hash on all five writers
   broken        an instance with a configuration the gateway refuses: its start fails, the error
                 is in `journalctl -u` at priority err, and after StartLimitBurst (5) starts systemd gives up
                 ("Start request repeated too quickly") instead of restarting forever
@@ -51,6 +53,8 @@ from harness import TestFailure, check, free_udp_port, read_json_lines, wait_for
 
 UNIT = "rsg-gateway@robot1.service"
 BROKEN = "rsg-gateway@broken.service"
+ROS2_INSTANCE = "ros2"  # a second instance, with --ros2 and the standard topics
+ROS2_UNIT = f"rsg-gateway@{ROS2_INSTANCE}.service"
 STATS = "/run/rsg/robot1/stats.json"
 WATCHDOG_S = 5  # WatchdogSec= of deploy/systemd/rsg-gateway@.service
 # What the watchdog kill may take beyond WatchdogSec: the SIGABRT's core dump and systemd's tick.
@@ -320,6 +324,34 @@ class Run:
         print(f"[service] upgrade: {self.deb_version(Path(self.args.old_deb))} -> {version}, pid {pid} restarted as "
               f"{new_pid}, the edited conffile kept", flush=True)
 
+    def ros2_type_hash(self):
+        """The packaged gateway as a second instance with --ros2 and the standard topics: a real rclpy
+        node on the host (make deps' ROS 2 environment) sees rosidl's RIHS01 type hash on every
+        ROS 2 writer, computed at the package's build without ROS 2."""
+        sys.path.insert(0, str(ROOT / "tests" / "ros2"))
+        from rclpy_common import RosEnv  # noqa: E402 (needs the ROS 2 environment only here)
+        env = RosEnv(self.domain)
+        self.box.sh(f"printf 'listen: 127.0.0.1:{free_udp_port()}\\ndomain: {self.domain}\\nros2: true\\n"
+                    f"joint-states: \"100\"\\ntf: \"every:5\"\\nexternal-wrench: \"50\"\\n' > /etc/rsg/{ROS2_INSTANCE}.yaml")
+        self.box.sh(f"systemctl start {ROS2_UNIT}")
+        try:
+            topics = {"/robot_state": ("rsg_msgs", "RobotState"), "/gateway_status": ("rsg_msgs", "GatewayStatus"),
+                      "/joint_states": ("sensor_msgs", "JointState"), "/tf": ("tf2_msgs", "TFMessage"),
+                      "/external_wrench": ("geometry_msgs", "WrenchStamped")}
+            graph = subprocess.run(env.argv("graph", *topics, "--wait-publishers", 1, "--timeout", 30),
+                                   capture_output=True, text=True, timeout=90)
+            check(graph.returncode == 0, f"the rclpy graph query failed: {graph.stderr[-1000:]}")
+            publishers = json.loads(graph.stdout.strip().splitlines()[-1])["publishers"]
+            for topic, (package, name) in topics.items():
+                check(len(publishers[topic]) == 1, f"{topic}: {len(publishers[topic])} publishers in the ROS graph")
+                want = env.type_hash(package, name) if package == "rsg_msgs" else env.standard_type_hash(package, name)
+                got = publishers[topic][0]["topic_type_hash"]
+                check(got == want, f"{topic} ({package}/msg/{name}) announces type hash {got}, rosidl computed {want}")
+        finally:
+            self.box.sh(f"systemctl stop {ROS2_UNIT}; rm -f /etc/rsg/{ROS2_INSTANCE}.yaml", check_status=False)
+        print(f"[service] ros2_type_hash: rosidl's hash on all {len(topics)} ROS 2 writers of the packaged "
+              f"gateway ({ROS2_UNIT})", flush=True)
+
     def broken(self):
         self.box.sh("printf 'listen: 127.0.0.1:1\\nno-such-key: 1\\n' > /etc/rsg/broken.yaml")
         start = subprocess.run([*self.box.engine, "exec", self.box.name, "systemctl", "start", BROKEN],
@@ -373,7 +405,7 @@ class Run:
         subprocess.run(["fastdds", "shm", "clean"], capture_output=True)
 
 
-STEPS = ["install", "ready", "frames", "sigkill", "watchdog", "upgrade", "broken", "purge"]
+STEPS = ["install", "ready", "frames", "sigkill", "watchdog", "upgrade", "ros2_type_hash", "broken", "purge"]
 
 
 def main():
