@@ -466,25 +466,14 @@ def ros2_type_hash(c):
     seen by a real rclpy node (make deps' ROS 2 environment on the host) with rosidl's RIHS01 type
     hash on every writer, where it once showed INVALID."""
     sys.path.insert(0, str(ROOT / "tests" / "ros2"))
-    from rclpy_common import RosEnv  # noqa: E402 (needs the ROS 2 environment only here)
+    from rclpy_common import RosEnv, check_rosidl_type_hashes  # noqa: E402 (the ROS 2 environment only here)
     env = RosEnv(c.domain)
     c.start("gateway", "--listen", f"127.0.0.1:{free_udp_port()}", "--domain", c.domain, "--ros2",
             "--joint-states", "100", "--tf", "every:5", "--external-wrench", "50",
             mounts=[f"{c.stats_dir}:{STATS_DIR}"])
     wait_for_stats(c.stats, lambda s: True, "the gateway container to start", timeout_s=60)
-    topics = {"/robot_state": ("rsg_msgs", "RobotState"), "/gateway_status": ("rsg_msgs", "GatewayStatus"),
-              "/joint_states": ("sensor_msgs", "JointState"), "/tf": ("tf2_msgs", "TFMessage"),
-              "/external_wrench": ("geometry_msgs", "WrenchStamped")}
-    graph = subprocess.run(env.argv("graph", *topics, "--wait-publishers", 1, "--timeout", 30),
-                           capture_output=True, text=True, timeout=90)
-    check(graph.returncode == 0, f"the rclpy graph query failed: {graph.stderr[-1000:]}")
-    publishers = json.loads(graph.stdout.strip().splitlines()[-1])["publishers"]
-    for topic, (package, name) in topics.items():
-        check(len(publishers[topic]) == 1, f"{topic}: {len(publishers[topic])} publishers in the ROS graph")
-        want = env.type_hash(package, name) if package == "rsg_msgs" else env.standard_type_hash(package, name)
-        got = publishers[topic][0]["topic_type_hash"]
-        check(got == want, f"{topic} ({package}/msg/{name}) announces type hash {got}, rosidl computed {want}")
-    print(f"[image] ros2_type_hash: rosidl's hash on all {len(topics)} ROS 2 writers of the image's gateway", flush=True)
+    checked = check_rosidl_type_hashes(env)
+    print(f"[image] ros2_type_hash: rosidl's hash on all {checked} ROS 2 writers of the image's gateway", flush=True)
 
 
 CASES = {"pipeline": pipeline, "health": health, "view_and_restart": view_and_restart, "compose": compose,

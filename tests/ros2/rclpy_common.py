@@ -81,6 +81,27 @@ def hash_hint(announced):
             "cmake/rsg_ros2_type_hashes.cmake, or its type is not listed there)")
 
 
+# Every ROS 2 writer of a gateway run with --ros2 and the three standard topics, by topic.
+GATEWAY_ROS2_TYPES = {"/robot_state": ("rsg_msgs", "RobotState"), "/gateway_status": ("rsg_msgs", "GatewayStatus"),
+                      "/joint_states": ("sensor_msgs", "JointState"), "/tf": ("tf2_msgs", "TFMessage"),
+                      "/external_wrench": ("geometry_msgs", "WrenchStamped")}
+
+
+def check_rosidl_type_hashes(env):
+    """A real rclpy node's view of the ROS graph on env's domain: one publisher on each topic of
+    GATEWAY_ROS2_TYPES, announcing the RIHS01 hash rosidl computes for its type. Returns how many."""
+    graph = subprocess.run(env.argv("graph", *GATEWAY_ROS2_TYPES, "--wait-publishers", 1, "--timeout", 30),
+                           capture_output=True, text=True, timeout=90)
+    check(graph.returncode == 0, f"the rclpy graph query failed: {graph.stderr[-1000:]}")
+    publishers = json.loads(graph.stdout.strip().splitlines()[-1])["publishers"]
+    for topic, (package, name) in GATEWAY_ROS2_TYPES.items():
+        check(len(publishers[topic]) == 1, f"{topic}: {len(publishers[topic])} publishers in the ROS graph")
+        want = env.type_hash(package, name) if package == "rsg_msgs" else env.standard_type_hash(package, name)
+        got = publishers[topic][0]["topic_type_hash"]
+        check(got == want, f"{topic} ({package}/msg/{name}) announces type hash {got}, rosidl computed {want}")
+    return len(GATEWAY_ROS2_TYPES)
+
+
 def start_peer(h, env, label, *args):
     return h.start(label, env.argv(*args))
 

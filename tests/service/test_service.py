@@ -329,27 +329,16 @@ class Run:
         node on the host (make deps' ROS 2 environment) sees rosidl's RIHS01 type hash on every
         ROS 2 writer, computed at the package's build without ROS 2."""
         sys.path.insert(0, str(ROOT / "tests" / "ros2"))
-        from rclpy_common import RosEnv  # noqa: E402 (needs the ROS 2 environment only here)
+        from rclpy_common import RosEnv, check_rosidl_type_hashes  # noqa: E402 (the ROS 2 environment only here)
         env = RosEnv(self.domain)
         self.box.sh(f"printf 'listen: 127.0.0.1:{free_udp_port()}\\ndomain: {self.domain}\\nros2: true\\n"
                     f"joint-states: \"100\"\\ntf: \"every:5\"\\nexternal-wrench: \"50\"\\n' > /etc/rsg/{ROS2_INSTANCE}.yaml")
         self.box.sh(f"systemctl start {ROS2_UNIT}")
         try:
-            topics = {"/robot_state": ("rsg_msgs", "RobotState"), "/gateway_status": ("rsg_msgs", "GatewayStatus"),
-                      "/joint_states": ("sensor_msgs", "JointState"), "/tf": ("tf2_msgs", "TFMessage"),
-                      "/external_wrench": ("geometry_msgs", "WrenchStamped")}
-            graph = subprocess.run(env.argv("graph", *topics, "--wait-publishers", 1, "--timeout", 30),
-                                   capture_output=True, text=True, timeout=90)
-            check(graph.returncode == 0, f"the rclpy graph query failed: {graph.stderr[-1000:]}")
-            publishers = json.loads(graph.stdout.strip().splitlines()[-1])["publishers"]
-            for topic, (package, name) in topics.items():
-                check(len(publishers[topic]) == 1, f"{topic}: {len(publishers[topic])} publishers in the ROS graph")
-                want = env.type_hash(package, name) if package == "rsg_msgs" else env.standard_type_hash(package, name)
-                got = publishers[topic][0]["topic_type_hash"]
-                check(got == want, f"{topic} ({package}/msg/{name}) announces type hash {got}, rosidl computed {want}")
+            checked = check_rosidl_type_hashes(env)
         finally:
             self.box.sh(f"systemctl stop {ROS2_UNIT}; rm -f /etc/rsg/{ROS2_INSTANCE}.yaml", check_status=False)
-        print(f"[service] ros2_type_hash: rosidl's hash on all {len(topics)} ROS 2 writers of the packaged "
+        print(f"[service] ros2_type_hash: rosidl's hash on all {checked} ROS 2 writers of the packaged "
               f"gateway ({ROS2_UNIT})", flush=True)
 
     def broken(self):
