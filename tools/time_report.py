@@ -59,7 +59,9 @@ def main():
     if not args.skip_build:
         env = {**os.environ, "CCACHE_DISABLE": "1"}
         subprocess.run(["cmake", "-S", str(REPO), "-B", str(build), "-G", "Ninja", "-DCMAKE_BUILD_TYPE=RelWithDebInfo",
-                        f"-DRSG_DEPS_DIR={REPO / '.deps'}"], check=True, env=env, stdout=subprocess.DEVNULL)
+                        # make build's OPT_FLAGS (Makefile): -O2 with line tables only
+                        "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG", "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG",
+                        "-DRSG_BUILD_TESTS=ON", f"-DRSG_DEPS_DIR={REPO / '.deps'}"], check=True, env=env, stdout=subprocess.DEVNULL)
         subprocess.run(["ninja", "-C", str(build), "-t", "clean"], check=True, stdout=subprocess.DEVNULL)
         started = time.monotonic()
         subprocess.run(["ninja", "-C", str(build), f"-j{os.cpu_count()}"], check=True, env=env,

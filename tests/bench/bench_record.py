@@ -20,6 +20,9 @@ import tempfile
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "support"))
+from test_domain import acquire_domain  # noqa: E402  (the domain pool of ctest -j)
+
 
 def free_udp_port():
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
@@ -50,7 +53,7 @@ def main():
     args = parser.parse_args()
     bin_dir = Path(args.build) / "bin"
     work = Path(tempfile.mkdtemp(prefix="rsg_bench_record_"))
-    domain = os.getpid() % 200 + 10
+    domain = acquire_domain()
     port = free_udp_port()
     children = []
     try:

@@ -34,7 +34,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "integration"))
-from harness import free_udp_port  # noqa: E402
+from harness import acquire_domain, free_udp_port  # noqa: E402
 from scale import cpu_model  # noqa: E402  (tests/bench, next to this file)
 
 PROFILES = ROOT / "xml_profiles"
@@ -141,7 +141,7 @@ def main():
         (out / "late_join.json").write_text(json.dumps(results, indent=1) + "\n")
         (out / "late_join.md").write_text(render(results))
         return 0
-    domain = os.getpid() % 80 + 140
+    domain = acquire_domain()
     results = {"cpu": cpu_model(), "cores": os.cpu_count(), "starts": args.starts, "variants": {}}
     with tempfile.TemporaryDirectory(prefix="rsg_late_join_") as scratch:
         profiles = Path(scratch) / "profiles"

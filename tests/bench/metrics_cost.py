@@ -31,7 +31,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[0] / "integration"))
 sys.path.insert(0, str(HERE / "readers"))
-from harness import free_udp_port, read_json, wait_for  # noqa: E402
+from harness import acquire_domain, free_udp_port, read_json, wait_for  # noqa: E402
 from metrics_support import free_tcp_port  # noqa: E402
 from readers import realtime_prefix, terminate  # noqa: E402
 
@@ -154,7 +154,7 @@ def main():
     parser.add_argument("--fast-interval", type=float, default=0.01)
     parser.add_argument("--out", required=True)
     args = parser.parse_args()
-    domain = 100 + os.getpid() % 80
+    domain = acquire_domain()
     points = []
     with tempfile.TemporaryDirectory(prefix="rsg_bench_metrics_") as tmp:
         for round_ in range(1, args.rounds + 1):

@@ -61,6 +61,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "net"))
 from netbed import HOSTS, NetBed, discovery_server_argv  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "support"))
+from test_domain import acquire_domain  # noqa: E402
+
 RAW_PORT = 17000
 DS_PORT = 11811
 PAGE = os.sysconf("SC_PAGE_SIZE")
@@ -108,7 +111,7 @@ class Point:
         self.args, self.bed, self.dir = args, bed, Path(scratch)
         self.robots, self.readers = robots, readers
         self.participant_profile = participant_profile
-        self.domain = os.getpid() % 100 + 100
+        self.domain = acquire_domain()
         self.processes = []
         self.discovery = ["--discovery-server", f"{HOSTS['gw']}:{DS_PORT}"] if args.discovery_server else []
 

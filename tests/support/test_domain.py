@@ -56,6 +56,11 @@ def acquire_domain(inheritable=False):
                        f"tests (locks in {LOCK_DIR}): run fewer tests at once")
 
 
+def release_domain(domain):
+    """Gives back a domain this process acquired (a benchmark that wants a fresh domain per point)."""
+    os.close(_held.pop(domain))
+
+
 def test_domain():
     """The DDS domain of this test: the first one the process acquired (acquired on the first call)."""
     return next(iter(_held)) if _held else acquire_domain()

@@ -38,7 +38,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1] / "integration"))
 sys.path.insert(0, str(HERE.parents[1] / "ros2"))
-from harness import free_udp_port, read_json, wait_for  # noqa: E402
+from harness import acquire_domain, free_udp_port, read_json, wait_for  # noqa: E402
+from test_domain import release_domain  # noqa: E402  (tests/support, on the path through harness)
 
 TICKS = os.sysconf("SC_CLK_TCK")
 ROS_FILTER = "group_present[2] = TRUE"
@@ -176,15 +177,19 @@ def main():
     args.gateway = args.gateway or str(Path(args.bin) / "rsg_gateway")
     counts = [int(c) for c in args.counts.split(",")]
     kinds = args.kinds.split(",")
-    base_domain = 100 + os.getpid() % 80
     points = []
     with tempfile.TemporaryDirectory(prefix="rsg_bench_readers_") as tmp:
         scratch = Path(tmp)
-        index = 0
+        last_domain = None
         for count in counts:
             for kind in (kinds if count else kinds[:1]):
-                point = run_point(args, kind, count, base_domain + index % 20, scratch)
-                index += 1
+                # A domain per point, so that no participant of the last point is still discovered
+                # (the next one taken before the last is given back: the pool would hand it out again).
+                domain = acquire_domain()
+                if last_domain is not None:
+                    release_domain(last_domain)
+                last_domain = domain
+                point = run_point(args, kind, count, domain, scratch)
                 points.append(point)
                 print(json.dumps(point), flush=True)
     cpu_model = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
