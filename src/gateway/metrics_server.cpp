@@ -12,6 +12,7 @@
 #include <optional>
 #include <thread>
 
+#include "http_reply.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::gateway {
@@ -93,20 +94,9 @@ class Session : public std::enable_shared_from_this<Session> {
 
   void respond(unsigned version, bool keep_alive, http::status status, std::string body,
                std::string_view type = "text/plain; charset=utf-8") {
-    auto response = std::make_shared<http::response<http::string_body>>(status, version);
-    response->set(http::field::server, "rsg_gateway");
-    response->set(http::field::content_type, beast::string_view(type.data(), type.size()));
-    response->set(http::field::cache_control, "no-cache");
-    response->keep_alive(keep_alive);
-    response->body() = std::move(body);
-    response->prepare_payload();
     stream_.expires_after(MetricsServer::kRequestTimeout);
-    http::async_write(stream_, *response,
-                      [self = shared_from_this(), response](beast::error_code ec, std::size_t) {
-                        if (!ec && response->keep_alive()) return self->read();
-                        beast::error_code ignored;
-                        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
-                      });
+    app::write_http_reply(shared_from_this(), stream_, "rsg_gateway", version, keep_alive,
+                          {status, type, std::move(body)});
   }
 
   beast::tcp_stream stream_;

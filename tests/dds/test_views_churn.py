@@ -39,6 +39,9 @@ ROS_FILTER = "group_present[2] = TRUE AND group_present[3] = TRUE"
 # RSG_CHURN_CONTROL=1: the same churn with plain readers only, the control for the stall figures
 # (docs/benchmarks/views_churn.md); the final checks are the same.
 CONTROL = bool(os.environ.get("RSG_CHURN_CONTROL"))
+# RSG_CHURN_GATEWAY_ARGS="--rt-priority 30": more flags for the gateway (real-time mode), for the
+# stall figures of docs/benchmarks/readers/README.md.
+GATEWAY_ARGS = os.environ.get("RSG_CHURN_GATEWAY_ARGS", "").split()
 ECHO_VIEWS = [["--view", "view_kinematics"], ["--groups", "2,3"], ["--view", "view_joints"], ["--view", "view_forces"]]
 
 
@@ -70,7 +73,7 @@ def realtime_prefix():
 def body(h):
     env = RosEnv(h.domain)
     port = free_udp_port()
-    gateway, stats = h.gateway("gw", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000", "--ros2")
+    gateway, stats = h.gateway("gw", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000", "--ros2", *GATEWAY_ARGS)
     wait_for_stats(stats, lambda s: True, "the gateway to start")
     echo = h.binary("rsg_echo")
     domain = ["--domain", str(h.domain)]

@@ -19,6 +19,7 @@
 #include <thread>
 #include <variant>
 
+#include "http_reply.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::tools::view {
@@ -344,19 +345,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 
   void respond(const http::request<http::string_body>& request, http::status status, std::string_view type,
                std::string body) {
-    auto response = std::make_shared<http::response<http::string_body>>(status, request.version());
-    response->set(http::field::server, "rsg_view");
-    response->set(http::field::content_type, beast::string_view(type.data(), type.size()));
-    response->set(http::field::cache_control, "no-cache");
-    response->keep_alive(request.keep_alive());
-    if (request.method() != http::verb::head) response->body() = std::move(body);
-    response->prepare_payload();
-    http::async_write(stream_, *response,
-                      [self = shared_from_this(), response](beast::error_code ec, std::size_t) {
-                        if (!ec && response->keep_alive()) return self->read();
-                        beast::error_code ignored;
-                        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
-                      });
+    if (request.method() == http::verb::head) body.clear();
+    app::write_http_reply(shared_from_this(), stream_, "rsg_view", request.version(), request.keep_alive(),
+                          {status, type, std::move(body)});
   }
 
   beast::tcp_stream stream_;
