@@ -5,9 +5,13 @@ ASAN_BUILD ?= build-asan
 FUZZ_BUILD ?= build-fuzz
 JOBS       ?= $(shell nproc)
 # Tests side by side: each test that opens DDS holds a domain of its own (tests/support/test_domain.py),
-# and those that must run alone are RUN_SERIAL (CONTRIBUTING.md, Tests).
-CTEST_JOBS ?= $(JOBS)
+# and those that must run alone are RUN_SERIAL (CONTRIBUTING.md, Tests). One more than the cores:
+# the tests mostly wait (about 95 CPU-s in a run of 150 s on 2 cores; docs/development.md).
+CTEST_JOBS ?= $(shell echo $$(( $$(nproc) + 1 )))
 FUZZ_SECONDS ?= 30
+# make test's fuzzing: each fuzzer this long, from its seed corpus (a smoke run that keeps the loop
+# short); .ci/run gives it 20 s and `make fuzz FUZZ_SECONDS=600` is the long run.
+TEST_FUZZ_SECONDS ?= 10
 # Fast DDS 2.9.1 deletes an RTPSReader through the wrong type in its own destructor
 # (~RTPSReader, 64 vs 56 bytes); that report is about the library, not about rsg.
 ASAN_OPTIONS ?= new_delete_type_mismatch=0
@@ -91,11 +95,11 @@ fuzz: fuzz-build
 	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_JOBS=$(JOBS) tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD) 2>&1 | tee $(FUZZ_BUILD)/fuzz.log
 
 # What a contributor runs: every ctest test but those labelled long, side by side; the unit tests
-# again under ASan+UBSan; every fuzzer for 20 s (docs/development.md has the time each part takes).
+# again under ASan+UBSan; every fuzzer for TEST_FUZZ_SECONDS (docs/development.md has the time each part takes).
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -LE long 2>&1 | tee ctest.log
 	$(MAKE) unit-asan
-	$(MAKE) fuzz FUZZ_SECONDS=20
+	$(MAKE) fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS)
 	@tests/summarize.sh $(BUILD)/ctest.log $(ASAN_BUILD)/ctest.log -- $(FUZZ_BUILD)/fuzz.log
 
 # The long scenarios (ctest label long: network namespaces, reliability under load, churn and
