@@ -19,6 +19,9 @@ ASAN_OPTIONS ?= new_delete_type_mismatch=0
 packages    = $(shell grep -hv '^\s*\#' $(addprefix docker/packages/,$(addsuffix .txt,$(1))))
 # Project-local tools from PyPI and the Go module proxy, pinned with hashes (git-ignored).
 DEPS_DIR   ?= $(CURDIR)/.deps
+# Where Go's module and build caches are kept for every checkout on this machine (content-addressed,
+# like ccache's ~/.cache/ccache): a fresh clone's make deps builds rsg-mcap-check in 0.4 s, not 20 s.
+export RSG_CACHE_DIR ?= $(HOME)/.cache/rsg
 # Every CMake configure gets these: ccache (docker/packages/build.txt) makes the three builds of
 # `make test` and a rebuild after a branch switch cheap (paths relative to the checkout, so clones
 # share the cache); RSG_DEPS_DIR is where make deps put the project-local tools.
