@@ -1,6 +1,7 @@
 #include "flight_recorder.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <ctime>
 #include <stdexcept>
 
@@ -55,22 +56,42 @@ void FlightRecorder::commit(const transport::DatagramBatch& batch, std::size_t r
   count_ = std::min(count_ + received, kept_capacity_);
 }
 
-FlightRecorder::Dump FlightRecorder::dump(std::string_view reason) {
+FlightRecorder::Snapshot FlightRecorder::snapshot(std::string_view reason) {
   const auto now = std::chrono::system_clock::now();
-  Dump result;
+  Snapshot result;
   result.path = options_.dir / ("rsg_flight_" + utc_stamp(now) + "_" + std::to_string(++dumps_) + "_" +
                                 std::string(reason) + ".pcap");
-  capture::PcapWriter writer(result.path.string());
-  if (count_ > 0) {
-    const std::size_t oldest = (next_ + slots_ - count_) % slots_;
-    const auto newest = entries_[(next_ + slots_ - 1) % slots_].time;
-    const auto window = std::chrono::duration_cast<std::chrono::nanoseconds>(options_.window);
-    for (std::size_t i = 0; i < count_; ++i) {
-      const std::size_t index = (oldest + i) % slots_;
-      const Entry& entry = entries_[index];
-      if (newest - entry.time > window) continue;
-      if (writer.write({entry.time, entry.from, listen_, {slot(index), entry.size}})) ++result.frames;
-    }
+  result.to = listen_;
+  if (count_ == 0) return result;
+  const std::size_t oldest = (next_ + slots_ - count_) % slots_;
+  const auto newest = entries_[(next_ + slots_ - 1) % slots_].time;
+  const auto window = std::chrono::duration_cast<std::chrono::nanoseconds>(options_.window);
+  std::size_t first = 0;  // entries are in arrival order: skip those older than the window
+  while (first < count_ && newest - entries_[(oldest + first) % slots_].time > window) ++first;
+  std::size_t total = 0;
+  for (std::size_t i = first; i < count_; ++i) total += entries_[(oldest + i) % slots_].size;
+  result.datagrams.reserve(count_ - first);
+  result.bytes.resize(total);
+  std::size_t offset = 0;
+  for (std::size_t i = first; i < count_; ++i) {
+    const std::size_t index = (oldest + i) % slots_;
+    const Entry& entry = entries_[index];
+    std::memcpy(result.bytes.data() + offset, slot(index), entry.size);
+    result.datagrams.push_back({entry.time, entry.from, offset, entry.size});
+    offset += entry.size;
+  }
+  return result;
+}
+
+FlightRecorder::Dump FlightRecorder::write(const Snapshot& snapshot) {
+  Dump result{snapshot.path, 0};
+  capture::PcapWriter writer(snapshot.path.string());
+  for (const Snapshot::Datagram& datagram : snapshot.datagrams) {
+    if (writer.write({datagram.time,
+                      datagram.from,
+                      snapshot.to,
+                      {snapshot.bytes.data() + datagram.offset, datagram.size}}))
+      ++result.frames;
   }
   writer.flush();
   return result;

@@ -4,8 +4,9 @@
 //
 // The ring is allocated at start-up, and the ingress receives straight into it
 // (DatagramBatch::receive_into): recording costs per frame no allocation and no copy, only a
-// timestamp and the sender's address. Only a dump allocates, and it runs on the ingress thread,
-// so frames wait in the socket's buffer while it writes.
+// timestamp and the sender's address. Only a dump allocates: the ingress thread copies the window's
+// datagrams out of the ring (`snapshot`), and another thread writes the file (`write`, DumpWriter),
+// so that a slow or hung disk never holds frames in the socket's buffer.
 #pragma once
 
 #include <chrono>
@@ -32,6 +33,20 @@ class FlightRecorder {
     std::size_t frames = 0;
   };
 
+  /// A dump's datagrams, copied out of the ring, ready to be written on any thread.
+  struct Snapshot {
+    struct Datagram {
+      std::chrono::nanoseconds time{};  ///< arrival, since the Unix epoch
+      capture::UdpEndpoint from;
+      std::size_t offset = 0;  ///< into `bytes`
+      std::uint32_t size = 0;
+    };
+    std::filesystem::path path;       ///< DIR/rsg_flight_<UTC time>_<N>_<reason>.pcap
+    capture::UdpEndpoint to;          ///< the gateway's address
+    std::vector<Datagram> datagrams;  ///< oldest first
+    std::vector<std::uint8_t> bytes;
+  };
+
   /// `listen`: the gateway's address, the destination in the dumps. `batch`: the receive batch the
   /// ring lends its slots to; one datagram of it takes at most `batch.buffer_bytes()`.
   FlightRecorder(const Options& options, const transport::Endpoint& listen,
@@ -48,9 +63,12 @@ class FlightRecorder {
   void commit(const transport::DatagramBatch& batch, std::size_t received,
               std::chrono::system_clock::time_point now);
 
-  /// Writes the datagrams of the last `window` before the newest one, oldest first, to
-  /// DIR/rsg_flight_<UTC time>_<N>_<reason>.pcap. @throws rsg::EnvironmentError when it cannot.
-  Dump dump(std::string_view reason);
+  /// Copies the datagrams of the last `window` before the newest one, oldest first, and names
+  /// their file. Allocates: call it on a request or a link change, never per frame.
+  Snapshot snapshot(std::string_view reason);
+
+  /// Writes `snapshot` as a pcap file. @throws rsg::EnvironmentError when it cannot.
+  static Dump write(const Snapshot& snapshot);
 
  private:
   struct Entry {

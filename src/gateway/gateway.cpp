@@ -234,6 +234,7 @@ Gateway::Gateway(const GatewaySetup& setup)
       stats_file_(config_.stats_file) {
   if (setup.ingress) {
     ingress_.emplace(participant_, *setup.ingress);
+    if (ingress_->has_flight_recorder()) dump_writer_.emplace();
     spdlog::info("ingress: frames on UDP {} -> topic '{}' (domain {})",
                  ingress_->local_endpoint().to_string(), setup.ingress->topic, config_.domain);
     if (const auto& standard = setup.ingress->standard_topics) {
@@ -311,12 +312,10 @@ void Gateway::dump_flight_recorder(std::string_view reason) {
     if (reason == "signal") spdlog::warn("SIGUSR1: no flight recorder to dump (start with --pcap-ring)");
     return;
   }
-  try {
-    const auto dumped = ingress_->dump_flight_recorder(reason);
-    spdlog::info("flight recorder ({}): {} datagrams in {}", reason, dumped->frames, dumped->path.string());
-  } catch (const std::exception& error) {
-    spdlog::error("flight recorder ({}): {}", reason, error.what());
-  }
+  // The copy here, the file on the dump writer's thread: this is the ingress thread.
+  if (!dump_writer_->post(std::move(*ingress_->flight_recorder_snapshot(reason)), std::string(reason)))
+    spdlog::error("flight recorder ({}): not dumped, {} earlier dumps are still being written", reason,
+                  DumpWriter::kMaxPending);
 }
 
 GatewayStats Gateway::on_status_period(Clock::time_point now) {

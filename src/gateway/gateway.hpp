@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "config.hpp"
+#include "dump_writer.hpp"
 #include "egress.hpp"
 #include "ingress.hpp"
 #include "link_monitor.hpp"
@@ -66,10 +67,11 @@ class Gateway {
   RateMeter rate_;
   double rate_hz_ = 0;
   Clock::time_point next_summary_{};
-  std::optional<NoLinkWarning> no_link_;  // with ingress
-  StatsFile stats_file_;                  // --stats-file, written by a thread of its own
-  double link_last_change_s_ = 0;         // Unix time, for the metrics
-  std::optional<MetricsServer> metrics_;  // last: serves snapshots of everything above
+  std::optional<NoLinkWarning> no_link_;   // with ingress
+  StatsFile stats_file_;                   // --stats-file, written by a thread of its own
+  std::optional<DumpWriter> dump_writer_;  // with a flight recorder: writes its dumps
+  double link_last_change_s_ = 0;          // Unix time, for the metrics
+  std::optional<MetricsServer> metrics_;   // last: serves snapshots of everything above
 };
 
 /// Puts the calling thread (the one that will call `Gateway::run`) in the configured real-time

@@ -217,9 +217,9 @@ void Ingress::request_selection(const transport::Endpoint& robot, Clock::time_po
     spdlog::warn("could not send the selection request to {}", robot.to_string());
 }
 
-std::optional<FlightRecorder::Dump> Ingress::dump_flight_recorder(std::string_view reason) {
+std::optional<FlightRecorder::Snapshot> Ingress::flight_recorder_snapshot(std::string_view reason) {
   if (!recorder_) return std::nullopt;
-  return recorder_->dump(reason);
+  return recorder_->snapshot(reason);
 }
 
 bool Ingress::link_changed(Clock::time_point now) {

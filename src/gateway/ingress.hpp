@@ -96,10 +96,9 @@ class Ingress {
 
   transport::Endpoint local_endpoint() const { return socket_.local_endpoint(); }
 
-  /// Writes the flight recorder's datagrams as a pcap file; nothing when it is off. Allocates and
-  /// writes a file: call it on a request or a link change, not per frame.
-  /// @throws rsg::EnvironmentError when the file cannot be written.
-  std::optional<FlightRecorder::Dump> dump_flight_recorder(std::string_view reason);
+  /// The flight recorder's datagrams, copied for a dump (FlightRecorder::snapshot); nothing when it
+  /// is off. Allocates: call it on a request or a link change, not per frame.
+  std::optional<FlightRecorder::Snapshot> flight_recorder_snapshot(std::string_view reason);
   bool has_flight_recorder() const { return recorder_.has_value(); }
 
   /// The standard ROS 2 topics, when any is on.

@@ -1,5 +1,6 @@
 #include "metrics_server.hpp"
 
+#include <pthread.h>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
@@ -14,6 +15,7 @@
 
 #include "http_reply.hpp"
 #include "rsg/error.hpp"
+#include "tcp_listener.hpp"
 
 namespace rsg::gateway {
 namespace {
@@ -146,17 +148,13 @@ MetricsServer::MetricsServer(const Options& options, MetricsSnapshot first)
     : impl_(std::make_unique<Impl>()) {
   impl_->shared.options = options;
   impl_->shared.snapshot.store(std::make_shared<const MetricsSnapshot>(std::move(first)));
-  const tcp::endpoint endpoint = to_asio(options.listen);
-  beast::error_code ec;
-  auto& acceptor = impl_->acceptor;
-  acceptor.open(endpoint.protocol(), ec);
-  if (!ec) acceptor.set_option(net::socket_base::reuse_address(true), ec);
-  if (!ec) acceptor.bind(endpoint, ec);
-  if (!ec) acceptor.listen(net::socket_base::max_listen_connections, ec);
-  if (ec)
+  if (const auto ec = rsg::app::listen_on(impl_->acceptor, to_asio(options.listen)))
     throw EnvironmentError("--metrics: cannot listen on " + options.listen.to_string() + ": " + ec.message());
   impl_->accept();
-  impl_->thread = std::thread([impl = impl_.get()] { impl->io.run(); });
+  impl_->thread = std::thread([impl = impl_.get()] {
+    ::pthread_setname_np(::pthread_self(), "rsg-metrics");
+    impl->io.run();
+  });
 }
 
 MetricsServer::~MetricsServer() {

@@ -36,6 +36,13 @@
 #         readers' CPU, frames published, largest ingress delay, link-down reports:
 #         bench/readers/readers_fastdds2.9.json. About 4 minutes.
 #         RSG_BENCH_READERS_SECONDS   measuring window per point (default 8)
+#   churn  readers of every kind joining and leaving a 1 kHz gateway (tests/dds/test_views_churn.py,
+#         views and the plain control, 3 runs each) with cyclictest alongside: the gateway's largest
+#         ingress delay next to the host's own largest real-time wake-up latency in the same run
+#         (tests/bench/readers/churn.py): bench/churn/churn_fastdds2.9.json and .md. About 9 minutes.
+#         RSG_BENCH_CHURN_RUNS        runs per kind (default 3)
+#         RSG_BENCH_CHURN_GATEWAY_ARGS  the gateway's flags (default --rt-priority 30; add --cpu N on
+#                                     a host with an isolated core)
 #   metrics  what Prometheus scraping costs rsg_gateway at 1 kHz (tests/bench/metrics_cost.py): the
 #         gateway's CPU with --metrics scraped once a second, side by side with metrics off, and the
 #         cost of one scrape (from 100 scrapes a second), alternating, over several rounds:
@@ -46,7 +53,7 @@
 # report_<suite> that prints them, plus its name in SUITES.
 set -euo pipefail
 
-SUITES=(wire e2e record scale late_join readers metrics)
+SUITES=(wire e2e record scale late_join readers churn metrics)
 
 here=$(cd "$(dirname "$0")" && pwd)
 usage() { echo "usage: $0 BUILD_DIR [${SUITES[*]}]" >&2; exit 2; }
@@ -160,6 +167,13 @@ run_readers() {
     --seconds "${RSG_BENCH_READERS_SECONDS:-8}" > "$out/readers.txt"
 }
 report_readers() { sed -n '/^###/,$p' "$out/readers.txt"; }
+
+run_churn() {
+  RSG_DEPS_DIR=$(sed -n 's/^RSG_DEPS_DIR:PATH=//p' "$build/CMakeCache.txt") \
+    python3 "$here/readers/churn.py" --bin "$build/bin" --out "$out/churn" --runs "${RSG_BENCH_CHURN_RUNS:-3}" \
+    --gateway-args "${RSG_BENCH_CHURN_GATEWAY_ARGS:---rt-priority 30}" > "$out/churn.txt"
+}
+report_churn() { sed -n '/^###/,$p' "$out/churn.txt"; }
 
 run_metrics() {
   python3 "$here/metrics_cost.py" --bin "$build/bin" --out "$out/metrics" --rounds "${RSG_BENCH_METRICS_ROUNDS:-4}" \

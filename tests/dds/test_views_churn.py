@@ -42,6 +42,8 @@ CONTROL = bool(os.environ.get("RSG_CHURN_CONTROL"))
 # RSG_CHURN_GATEWAY_ARGS="--rt-priority 30": more flags for the gateway (real-time mode), for the
 # stall figures of docs/benchmarks/readers/README.md.
 GATEWAY_ARGS = os.environ.get("RSG_CHURN_GATEWAY_ARGS", "").split()
+# RSG_CHURN_REPORT=FILE: the printed figures as JSON too (tests/bench/readers/churn.py reads them).
+REPORT = os.environ.get("RSG_CHURN_REPORT")
 ECHO_VIEWS = [["--view", "view_kinematics"], ["--groups", "2,3"], ["--view", "view_joints"], ["--view", "view_forces"]]
 
 
@@ -154,6 +156,12 @@ def body(h):
           f"rclpy processes {counts['rclpy_process'][0]}; rclpy contexts: {loop_err[-1] if loop_err else '?'}; "
           f"gateway ingress delay max {during['ingress_delay_max_us']} us; robot's longest silence {silent_us} us; "
           f"link-down reports {link_downs}", flush=True)
+    if REPORT:
+        Path(REPORT).write_text(json.dumps({
+            "control": CONTROL, "seconds": CHURN_S, "client_library": library_out,
+            "rsg_echo_processes": counts["echo"][0], "rclpy_processes": counts["rclpy_process"][0],
+            "ingress_delay_max_us": during["ingress_delay_max_us"], "robot_longest_silence_us": silent_us,
+            "link_down_reports": link_downs}))
 
     # The readers that stay: exactly their frames, in order. First every churned reader must be
     # gone from the writer's count (the SIGKILLed ones by lease expiry), or the count below could be

@@ -249,12 +249,13 @@ TEST_F(IngressAllocation, WithTheFlightRecorderOnNothingAllocates) {
   recorder.dir = dir;
   stream("ingress_alloc_best_effort", fdds::BEST_EFFORT_RELIABILITY_QOS, recorder,
          [&](Ingress& ingress, const std::vector<std::span<const std::uint8_t>>& sent) {
-           const auto dumped = ingress.dump_flight_recorder("test");
-           ASSERT_TRUE(dumped.has_value());
-           EXPECT_EQ(dumped->frames, 2401U);
-           capture::PcapReader reader(dumped->path.string());
+           const auto snapshot = ingress.flight_recorder_snapshot("test");
+           ASSERT_TRUE(snapshot.has_value());
+           const auto dumped = FlightRecorder::write(*snapshot);
+           EXPECT_EQ(dumped.frames, 2401U);
+           capture::PcapReader reader(dumped.path.string());
            const transport::Endpoint listen = ingress.local_endpoint();
-           std::size_t index = sent.size() - dumped->frames;
+           std::size_t index = sent.size() - dumped.frames;
            while (const auto packet = reader.next()) {
              ASSERT_LT(index, sent.size());
              const std::span<const std::uint8_t> datagram = sent[index++];

@@ -2,14 +2,17 @@
 writes the last second of datagrams as a pcap file, and again on SIGUSR1. Read by Debian's tshark
 (with rsg's dissector), the file holds exactly the newest datagrams the simulator sent (its own
 --pcap says which), oldest first, invalid ones included (a datagram longer than any frame cut to
-2137 bytes), spanning at most the configured second."""
+2137 bytes), spanning at most the configured second. A thread of its own writes the file: with that
+thread stopped (as on a hung disk) the gateway goes on publishing."""
 
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
-from harness import check, main, wait_for, wait_for_stats, free_udp_port
+from harness import check, main, read_json, wait_for, wait_for_stats, free_udp_port
+from thread_freeze import freeze_thread, thaw_thread, thread_named
 
 DISSECTOR = Path(__file__).resolve().parents[2] / "tools" / "wireshark" / "rsg_sendbuf.lua"
 RATE = 500
@@ -23,6 +26,39 @@ def read_capture(path):
                           capture_output=True, text=True, timeout=60)
     check(done.returncode == 0, f"tshark cannot read {path.name}: {done.stderr}")
     return [tuple(line.split("\t")) for line in done.stdout.splitlines()]
+
+
+def stuck_dump_writer(h, gateway, stats, port, dumps):
+    """A dump never holds up the ingress: with the thread that writes dumps stuck (as on a hung
+    disk), SIGUSR1 is still taken at once and frames keep being published; two dumps wait, a third
+    is refused with an error line, and once the thread runs again the two are written."""
+    writer = wait_for(lambda: thread_named(gateway.pid, "rsg-dump"), "the gateway's rsg-dump thread")
+
+    def signal_dumps():
+        return sorted(dumps.glob("*_signal.pcap"))
+    before = len(signal_dumps())
+    sim = h.start("sim_stuck", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", str(RATE),
+                                "--duration", "30"])
+    wait_for_stats(stats, lambda s: s["link_up"], "the stream to start again")
+    log = h.dir / "gateway.err"
+    freeze_thread(writer)
+    try:
+        for _ in range(3):
+            gateway.send_signal(signal.SIGUSR1)
+            time.sleep(0.2)
+        wait_for(lambda: "not dumped, 2 earlier dumps are still being written" in log.read_text(errors="replace"),
+                 "the third SIGUSR1's dump to be refused")
+        published = read_json(stats)["frames_published"]
+        wait_for_stats(stats, lambda s: s["frames_published"] >= published + RATE,
+                       "a second of frames published while the dump writer is stuck")
+        check(len(signal_dumps()) == before, "a dump was written while its writer thread was stopped")
+    finally:
+        thaw_thread(writer)
+    wait_for(lambda: len(signal_dumps()) == before + 2, "the two waiting dumps to be written")
+    for path in signal_dumps()[before:]:
+        check(len(read_capture(path)) >= RATE // 2, f"{path.name} holds less than the last second")
+    sim.send_signal(signal.SIGTERM)
+    h.wait("sim_stuck", sim, 30)
 
 
 def body(h):
@@ -43,6 +79,7 @@ def body(h):
     link_down = wait_for(lambda: sorted(dumps.glob("*_link_down.pcap")), "the dump on link down")[-1]
     gateway.send_signal(signal.SIGUSR1)
     on_signal = wait_for(lambda: sorted(dumps.glob("*_signal.pcap")), "the dump on SIGUSR1")[0]
+    stuck_dump_writer(h, gateway, stats, port, dumps)
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
 
     # The ring keeps at most the longest frame of a datagram (2137 bytes), as the gateway reads it.

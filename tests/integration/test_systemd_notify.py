@@ -11,7 +11,6 @@ that no one reads) does not stop the main loop: the stats file has a writer thre
 WATCHDOG=1 keeps arriving. The main loop alone is stuck the way a debugger stops one thread:
 ptrace (PTRACE_SEIZE + PTRACE_INTERRUPT) on the thread that runs it, the process's main thread."""
 
-import ctypes
 import os
 import signal
 import socket
@@ -23,6 +22,7 @@ from pathlib import Path
 
 from harness import check, free_udp_port, main, port_is_free, read_json, wait_for
 from metrics_support import free_tcp_port, http_get
+from thread_freeze import freeze_thread, thaw_thread
 
 WATCHDOG_USEC = 1_000_000
 
@@ -52,29 +52,6 @@ class NotifySocket(threading.Thread):
         self.stopping = True
         self.join()
         self.socket.close()
-
-
-_libc = ctypes.CDLL(None, use_errno=True)
-_libc.ptrace.argtypes = [ctypes.c_long, ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p]
-PTRACE_DETACH, PTRACE_SEIZE, PTRACE_INTERRUPT = 17, 0x4206, 0x4207
-WALL = 0x40000000
-
-
-def ptrace(request, tid):
-    if _libc.ptrace(request, tid, None, None) != 0:
-        error = ctypes.get_errno()
-        raise OSError(error, f"ptrace({request:#x}, {tid}): {os.strerror(error)}")
-
-
-def freeze_thread(tid):
-    """Stops the one thread `tid` (the other threads of its process run on) until thaw_thread()."""
-    ptrace(PTRACE_SEIZE, tid)
-    ptrace(PTRACE_INTERRUPT, tid)
-    os.waitpid(tid, WALL)  # until it is stopped
-
-
-def thaw_thread(tid):
-    ptrace(PTRACE_DETACH, tid)
 
 
 def body(h):

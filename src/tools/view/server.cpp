@@ -21,6 +21,7 @@
 
 #include "http_reply.hpp"
 #include "rsg/error.hpp"
+#include "tcp_listener.hpp"
 
 namespace rsg::tools::view {
 namespace {
@@ -389,15 +390,9 @@ Server::Server(const ServerOptions& options, std::vector<foxglove::Channel> chan
   beast::error_code ec;
   const auto address = net::ip::make_address(options.host, ec);
   if (ec) throw InputError("--listen: '" + options.host + "' is no IP address");
-  const tcp::endpoint endpoint(address, options.port);
-  auto& acceptor = impl_->acceptor;
-  acceptor.open(endpoint.protocol(), ec);
-  if (!ec) acceptor.set_option(net::socket_base::reuse_address(true), ec);
-  if (!ec) acceptor.bind(endpoint, ec);
-  if (!ec) acceptor.listen(net::socket_base::max_listen_connections, ec);
-  if (ec)
+  if (const auto listen_error = rsg::app::listen_on(impl_->acceptor, tcp::endpoint(address, options.port)))
     throw EnvironmentError("cannot listen on " + options.host + ":" + std::to_string(options.port) + ": " +
-                           ec.message());
+                           listen_error.message());
   impl_->accept();
   impl_->thread = std::thread([impl = impl_.get()] { impl->io.run(); });
 }

@@ -46,6 +46,7 @@ if Path(sys.prefix).resolve() != (DEPS / "mcap").resolve():
 
 sys.path.insert(0, str(ROOT / "tests" / "integration"))
 from harness import check, free_udp_port, main, read_json_lines, wait_for, wait_for_stats, wait_matched  # noqa: E402
+from replay_target import second_gateway_with_echo  # noqa: E402
 
 from mcap.reader import NonSeekingReader, SeekingReader  # noqa: E402
 from mcap_ros2.decoder import DecoderFactory  # noqa: E402
@@ -402,12 +403,7 @@ def rosbags_replay(h):
         print(f"[{h.name}] rosbags' bag ({label}) replayed over DDS: {count} samples as sent", flush=True)
 
     # As raw frames: rsg_replay --to a second gateway -> rsg_echo --json.
-    port = free_udp_port()
-    gateway2, stats2 = h.gateway("gateway2", "--listen", f"127.0.0.1:{port}", "--topic", "replayed",
-                                 "--status-topic", "replayed_status", "--expected-rate", "1000")
-    echo = h.start("echo_udp", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "replayed", "--json",
-                                "--count", str(count), "--timeout", "30"])
-    wait_for_stats(stats2, lambda s: s["state_readers"] >= 1, "rsg_echo to match the second gateway")
+    gateway2, port, echo = second_gateway_with_echo(h, count, "echo_udp")
     status = h.run("replay_udp", [h.binary("rsg_replay"), str(mcap_files[0]), "--to", f"127.0.0.1:{port}",
                                   "--speed", "2"])
     check(status == 0, f"rsg_replay --to exited {status}: {(h.dir / 'replay_udp.err').read_text()}")

@@ -20,6 +20,7 @@ ROOT = HERE.parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "integration"))
 from harness import (UdpRelay, check, free_udp_port, main, read_json_lines, receive_timed,  # noqa: E402
                      timed_receiver, wait_for, wait_for_stats, wait_matched)
+from replay_target import second_gateway_with_echo  # noqa: E402
 
 CASE = sys.argv[sys.argv.index("--case") + 1]
 del sys.argv[sys.argv.index("--case"):sys.argv.index("--case") + 2]
@@ -169,12 +170,7 @@ def replay_roundtrip(h):
     check(recorded["states"] == count, f"read {recorded}")
 
     # Raw: replay -> tap -> second gateway -> rsg_echo --json.
-    port2 = free_udp_port()
-    gateway2, stats2 = h.gateway("gateway2", "--listen", f"127.0.0.1:{port2}", "--topic", "replayed",
-                                 "--status-topic", "replayed_status", "--expected-rate", "1000")
-    echo = h.start("echo", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "replayed", "--json",
-                            "--count", str(count), "--timeout", "30"])
-    wait_for_stats(stats2, lambda s: s["state_readers"] >= 1, "rsg_echo to match the second gateway")
+    gateway2, port2, echo = second_gateway_with_echo(h, count, "echo")
     tap2_port = free_udp_port()
     tap2 = UdpRelay(tap2_port, forward_to=("127.0.0.1", port2))
     tap2.start()

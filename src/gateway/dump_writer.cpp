@@ -1,0 +1,47 @@
+#include "dump_writer.hpp"
+
+#include <pthread.h>
+#include <spdlog/spdlog.h>
+
+#include <exception>
+#include <utility>
+
+namespace rsg::gateway {
+
+DumpWriter::DumpWriter() : thread_([this](const std::stop_token& stop) { run(stop); }) {}
+
+// std::jthread asks run() to stop and joins it; run() writes what is pending first.
+DumpWriter::~DumpWriter() = default;
+
+bool DumpWriter::post(FlightRecorder::Snapshot snapshot, std::string reason) {
+  {
+    const std::lock_guard lock(mutex_);
+    if (pending_.size() >= kMaxPending) return false;
+    pending_.push_back({std::move(snapshot), std::move(reason)});
+  }
+  posted_.notify_one();
+  return true;
+}
+
+void DumpWriter::run(const std::stop_token& stop) {
+  ::pthread_setname_np(::pthread_self(), "rsg-dump");  // top -H, perf, tests find it by name
+  for (;;) {
+    Pending next;
+    {
+      std::unique_lock lock(mutex_);
+      posted_.wait(lock, stop, [this] { return !pending_.empty(); });
+      if (pending_.empty()) return;  // stopped, nothing left to write
+      next = std::move(pending_.front());
+      pending_.pop_front();
+    }
+    try {
+      const FlightRecorder::Dump dumped = FlightRecorder::write(next.snapshot);
+      spdlog::info("flight recorder ({}): {} datagrams in {}", next.reason, dumped.frames,
+                   dumped.path.string());
+    } catch (const std::exception& error) {
+      spdlog::error("flight recorder ({}): {}", next.reason, error.what());
+    }
+  }
+}
+
+}  // namespace rsg::gateway

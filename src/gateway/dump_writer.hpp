@@ -1,0 +1,47 @@
+// Writes the flight recorder's dumps on a thread of its own, so that the ingress thread, which
+// takes the snapshot, never waits on the disk.
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <mutex>
+#include <stop_token>
+#include <thread>
+
+#include "flight_recorder.hpp"
+
+namespace rsg::gateway {
+
+/// Each dump is logged when its file is complete ("flight recorder (REASON): N datagrams in PATH")
+/// or failed (an error line naming the file); failures are never thrown: the gateway goes on.
+class DumpWriter {
+ public:
+  /// Dumps that may wait while one is written; a further one is refused (a disk this slow would
+  /// only queue copies of the same seconds).
+  static constexpr std::size_t kMaxPending = 2;
+
+  DumpWriter();
+  /// Writes what is still pending, then stops the thread.
+  ~DumpWriter();
+  DumpWriter(const DumpWriter&) = delete;
+  DumpWriter& operator=(const DumpWriter&) = delete;
+
+  /// Queues `snapshot` (taken for `reason`) and returns at once; false, and nothing queued, when
+  /// kMaxPending dumps already wait.
+  bool post(FlightRecorder::Snapshot snapshot, std::string reason);
+
+ private:
+  struct Pending {
+    FlightRecorder::Snapshot snapshot;
+    std::string reason;
+  };
+  void run(const std::stop_token& stop);
+
+  std::mutex mutex_;
+  std::condition_variable_any posted_;
+  std::deque<Pending> pending_;  // guarded by mutex_
+  std::jthread thread_;          // last: started once everything it uses exists
+};
+
+}  // namespace rsg::gateway
