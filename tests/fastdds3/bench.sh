@@ -3,10 +3,12 @@
 # (Debian 13's 3.1.2, the chroot's build of tools/fastdds3/chroot.sh), one right after the other on
 # one machine, and the two side by side (tests/bench/compare_fastdds.py); then the readers suite
 # (tests/bench/readers/readers.py) with a 2.9 gateway and with a 3.1.2 gateway (the readers run on
-# the host in both). The committed runs and what they say: docs/benchmarks/fastdds3/.
+# the host in both), and the churn suite (tests/bench/readers/churn.py) with a 3.1.2 gateway. The
+# committed runs and what they say: docs/benchmarks/fastdds3/, docs/benchmarks/readers/.
 #
 #   tests/fastdds3/bench.sh [HOST_BUILD [SUITE...]]   HOST_BUILD: the host's 2.9 build tree (default
-#                                                     build); SUITE: e2e, readers (default both)
+#                                                     build); SUITE: e2e, readers, churn (default
+#                                                     e2e and readers)
 #
 # The RSG_BENCH_E2E_* durations of tests/bench/run_bench.sh apply to both runs.
 set -euo pipefail
@@ -24,17 +26,23 @@ $chroot setup
   $chroot in cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRSG_FASTDDS=3 \
     -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache > /dev/null
 $chroot in cmake --build "$build" -j "${JOBS:-$(nproc)}" --target "${targets[@]}"
-cmake --build "$host_build" -j "${JOBS:-$(nproc)}" --target "${targets[@]}" rsg_sim rsg_bench_reader_host
+cmake --build "$host_build" -j "${JOBS:-$(nproc)}" --target "${targets[@]}" rsg_sim rsg_bench_reader_host \
+  rsg_echo rsg_views_churn
 
+# The host's tools with a 3.x gateway: a script that runs the chroot's build (readers.py counts its
+# process tree).
+gateway3=$PWD/$build/bench/bin-gateway3
+$chroot mixed "$gateway3" "$PWD/$host_build/bin" "$PWD/$build/bin" rsg_gateway
 if [[ " ${suites[*]} " == *" readers "* ]]; then
-  # The 3.x gateway is a script that runs the chroot's build; readers.py counts its process tree.
-  wrapper=$build/bench/rsg_gateway_3
-  mkdir -p "$build/bench"
-  printf '#!/bin/sh\nexec %s in %s "$@"\n' "$PWD/$chroot" "$PWD/$build/bin/rsg_gateway" > "$wrapper"
-  chmod +x "$wrapper"
   python3 tests/bench/readers/readers.py --bin "$host_build/bin" --label fastdds2.9 --out "$build/bench/readers"
-  python3 tests/bench/readers/readers.py --bin "$host_build/bin" --gateway "$wrapper" --label fastdds3.1.2 \
-    --reader-qos reader_realtime_udp --out "$build/bench/readers"
+  python3 tests/bench/readers/readers.py --bin "$host_build/bin" --gateway "$gateway3/rsg_gateway" \
+    --label fastdds3.1.2 --reader-qos reader_realtime_udp --out "$build/bench/readers"
+fi
+if [[ " ${suites[*]} " == *" churn "* ]]; then
+  # make bench's churn suite with a 3.x gateway (2.9 readers on the host, rclpy's Fast DDS 3.2).
+  RSG_DEPS_DIR=$(sed -n 's/^RSG_DEPS_DIR:PATH=//p' "$host_build/CMakeCache.txt") \
+    python3 tests/bench/readers/churn.py --bin "$gateway3" --label fastdds3.1.2 --out "$build/bench/churn" \
+    --runs "${RSG_BENCH_CHURN_RUNS:-3}" --gateway-args "${RSG_BENCH_CHURN_GATEWAY_ARGS:---rt-priority 30}"
 fi
 [[ " ${suites[*]} " == *" e2e "* ]] || exit 0
 

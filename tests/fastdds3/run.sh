@@ -82,15 +82,9 @@ if [[ ! -x $host_build/bin/rsg_echo || ! -x $host_build/bin/rsg_views_publish ]]
   failed=$((failed + 1))
 else
   # Bin directories with each tool from one version: a 3.x tool is a script running it in the chroot.
-  mixed() {  # DIR TOOLS_FROM_3X...
+  mixed() {  # NAME TOOLS_FROM_3X...
     local dir=$logs/bin-$1; shift
-    rm -rf "$dir"; mkdir -p "$dir"
-    for tool in "$checkout/$host_build"/bin/rsg_*; do ln -s "$tool" "$dir/"; done
-    for tool in "$@"; do
-      rm -f "$dir/$tool"
-      printf '#!/bin/sh\nexec %s in %s "$@"\n' "$checkout/$chroot" "$checkout/$build/bin/$tool" > "$dir/$tool"
-      chmod +x "$dir/$tool"
-    done
+    $chroot mixed "$dir" "$checkout/$host_build/bin" "$checkout/$build/bin" "$@"
     echo "$dir"
   }
   gateway3=$(mixed gateway3 rsg_gateway)

@@ -6,6 +6,10 @@
 #   tools/fastdds3/chroot.sh in CMD...     run CMD inside the chroot, in the same directory (the checkout
 #                                          is mounted at its own path; RSG_CHROOT_ENV="A=1 B=2" passes
 #                                          variables in)
+#   tools/fastdds3/chroot.sh mixed DIR HOST_BIN CHROOT_BIN TOOL...
+#                                          make DIR a bin directory of HOST_BIN's tools (2.9) in which
+#                                          each TOOL is a script running CHROOT_BIN's (3.x) in the chroot:
+#                                          the cross-version tests and benchmarks take it as --bin
 #
 # The chroot lives in the git-ignored $RSG_TRIXIE_DIR (default .deps/trixie). `run` and `in` work in
 # a private mount namespace (unshare -m): /proc, /sys, /dev, /dev/shm, /tmp (files the tests hand
@@ -120,8 +124,26 @@ exec_in_namespace() {
     __mounted "$@"
 }
 
+mixed() {
+  local dir=$1 host_bin=$2 chroot_bin=$3 tool
+  shift 3
+  rm -rf "$dir"
+  mkdir -p "$dir"
+  for tool in "$host_bin"/rsg_*; do ln -s "$tool" "$dir/"; done
+  for tool in "$@"; do
+    rm -f "$dir/$tool"
+    printf '#!/bin/sh\nexec %s in %s "$@"\n' "$checkout/tools/fastdds3/chroot.sh" "$chroot_bin/$tool" > "$dir/$tool"
+    chmod +x "$dir/$tool"
+  done
+}
+
 case ${1:-} in
   setup) setup ;;
+  mixed)
+    shift
+    (($# >= 4)) || die "usage: $0 mixed DIR HOST_BIN CHROOT_BIN TOOL..."
+    mixed "$@"
+    ;;
   run | in)
     setup
     exec_in_namespace "$@"
@@ -133,5 +155,5 @@ case ${1:-} in
     shift
     if [[ $mode == in ]]; then in_chroot "$@"; else RSG_TRIXIE_ROOT=$root "$@"; fi
     ;;
-  *) die "usage: $0 setup | run CMD... | in CMD..." ;;
+  *) die "usage: $0 setup | run CMD... | in CMD... | mixed DIR HOST_BIN CHROOT_BIN TOOL..." ;;
 esac

@@ -122,7 +122,9 @@ def main():
             print(json.dumps(points[-1]), flush=True)
     text = table(args.label, points, args.gateway_args)
     machine = re.search(r"model name\s*:\s*(.*)", Path("/proc/cpuinfo").read_text())
-    result = {"label": args.label, "gateway_args": shlex.split(args.gateway_args), "goal_us": GOAL_US,
+    commit = subprocess.run(["git", "-C", str(HERE), "describe", "--always", "--dirty"], capture_output=True, text=True)
+    result = {"label": args.label, "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+              "commit": commit.stdout.strip() or "?", "gateway_args": shlex.split(args.gateway_args), "goal_us": GOAL_US,
               "cpu": machine.group(1) if machine else "?", "cpus": os.cpu_count(), "points": points}
     (out / f"churn_{args.label}.json").write_text(json.dumps(result, indent=1) + "\n")
     (out / f"churn_{args.label}.md").write_text(text + "\n")
