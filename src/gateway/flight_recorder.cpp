@@ -71,12 +71,12 @@ FlightRecorder::Snapshot FlightRecorder::snapshot(std::string_view reason) {
   std::size_t total = 0;
   for (std::size_t i = first; i < count_; ++i) total += entries_[(oldest + i) % slots_].size;
   result.datagrams.reserve(count_ - first);
-  result.bytes.resize(total);
+  result.bytes = std::make_unique_for_overwrite<std::uint8_t[]>(total);
   std::size_t offset = 0;
   for (std::size_t i = first; i < count_; ++i) {
     const std::size_t index = (oldest + i) % slots_;
     const Entry& entry = entries_[index];
-    std::memcpy(result.bytes.data() + offset, slot(index), entry.size);
+    std::memcpy(result.bytes.get() + offset, slot(index), entry.size);
     result.datagrams.push_back({entry.time, entry.from, offset, entry.size});
     offset += entry.size;
   }
@@ -90,7 +90,7 @@ FlightRecorder::Dump FlightRecorder::write(const Snapshot& snapshot) {
     if (writer.write({datagram.time,
                       datagram.from,
                       snapshot.to,
-                      {snapshot.bytes.data() + datagram.offset, datagram.size}}))
+                      {snapshot.bytes.get() + datagram.offset, datagram.size}}))
       ++result.frames;
   }
   writer.flush();

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string_view>
 #include <vector>
 
@@ -41,10 +42,10 @@ class FlightRecorder {
       std::size_t offset = 0;  ///< into `bytes`
       std::uint32_t size = 0;
     };
-    std::filesystem::path path;       ///< DIR/rsg_flight_<UTC time>_<N>_<reason>.pcap
-    capture::UdpEndpoint to;          ///< the gateway's address
-    std::vector<Datagram> datagrams;  ///< oldest first
-    std::vector<std::uint8_t> bytes;
+    std::filesystem::path path;             ///< DIR/rsg_flight_<UTC time>_<N>_<reason>.pcap
+    capture::UdpEndpoint to;                ///< the gateway's address
+    std::vector<Datagram> datagrams;        ///< oldest first
+    std::unique_ptr<std::uint8_t[]> bytes;  // not zeroed first: every byte is copied over
   };
 
   /// `listen`: the gateway's address, the destination in the dumps. `batch`: the receive batch the

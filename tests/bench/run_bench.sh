@@ -43,6 +43,9 @@
 #         RSG_BENCH_CHURN_RUNS        runs per kind (default 3)
 #         RSG_BENCH_CHURN_GATEWAY_ARGS  the gateway's flags (default --rt-priority 30; add --cpu N on
 #                                     a host with an isolated core)
+#   dumps  what a flight-recorder dump (SIGUSR1, 10 s ring) costs the stream at 1 kHz: the gateway's
+#         largest ingress delay in 2.5 s windows with a dump and without (tests/bench/dump_stall.py):
+#         bench/dumps/dump_stall.json. About 1.5 minutes.
 #   metrics  what Prometheus scraping costs rsg_gateway at 1 kHz (tests/bench/metrics_cost.py): the
 #         gateway's CPU with --metrics scraped once a second, side by side with metrics off, and the
 #         cost of one scrape (from 100 scrapes a second), alternating, over several rounds:
@@ -53,7 +56,7 @@
 # report_<suite> that prints them, plus its name in SUITES.
 set -euo pipefail
 
-SUITES=(wire e2e record scale late_join readers churn metrics)
+SUITES=(wire e2e record scale late_join readers churn dumps metrics)
 
 here=$(cd "$(dirname "$0")" && pwd)
 usage() { echo "usage: $0 BUILD_DIR [${SUITES[*]}]" >&2; exit 2; }
@@ -174,6 +177,9 @@ run_churn() {
     --gateway-args "${RSG_BENCH_CHURN_GATEWAY_ARGS:---rt-priority 30}" > "$out/churn.txt"
 }
 report_churn() { sed -n '/^###/,$p' "$out/churn.txt"; }
+
+run_dumps() { python3 "$here/dump_stall.py" --bin "$build/bin" --out "$out/dumps" > "$out/dumps.txt"; }
+report_dumps() { sed -n '/^###/,$p' "$out/dumps.txt"; }
 
 run_metrics() {
   python3 "$here/metrics_cost.py" --bin "$build/bin" --out "$out/metrics" --rounds "${RSG_BENCH_METRICS_ROUNDS:-4}" \
