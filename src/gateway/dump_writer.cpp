@@ -16,7 +16,10 @@ DumpWriter::~DumpWriter() = default;
 bool DumpWriter::post(FlightRecorder::Snapshot snapshot, std::string reason) {
   {
     const std::lock_guard lock(mutex_);
-    if (pending_.size() >= kMaxPending) return false;
+    if (pending_.size() >= kMaxPending) {
+      refused_.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
     pending_.push_back({std::move(snapshot), std::move(reason)});
   }
   posted_.notify_one();
@@ -36,9 +39,11 @@ void DumpWriter::run(const std::stop_token& stop) {
     }
     try {
       const FlightRecorder::Dump dumped = FlightRecorder::write(next.snapshot);
+      written_.fetch_add(1, std::memory_order_relaxed);
       spdlog::info("flight recorder ({}): {} datagrams in {}", next.reason, dumped.frames,
                    dumped.path.string());
     } catch (const std::exception& error) {
+      failed_.fetch_add(1, std::memory_order_relaxed);
       spdlog::error("flight recorder ({}): {}", next.reason, error.what());
     }
   }

@@ -2,8 +2,10 @@
 // takes the snapshot, never waits on the disk.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <mutex>
 #include <stop_token>
@@ -31,6 +33,11 @@ class DumpWriter {
   /// kMaxPending dumps already wait.
   bool post(FlightRecorder::Snapshot snapshot, std::string reason);
 
+  /// Dumps written, failed and refused since start (any thread).
+  std::uint64_t written() const { return written_.load(std::memory_order_relaxed); }
+  std::uint64_t failed() const { return failed_.load(std::memory_order_relaxed); }
+  std::uint64_t refused() const { return refused_.load(std::memory_order_relaxed); }
+
  private:
   struct Pending {
     FlightRecorder::Snapshot snapshot;
@@ -41,7 +48,10 @@ class DumpWriter {
   std::mutex mutex_;
   std::condition_variable_any posted_;
   std::deque<Pending> pending_;  // guarded by mutex_
-  std::jthread thread_;          // last: started once everything it uses exists
+  std::atomic<std::uint64_t> written_{0};
+  std::atomic<std::uint64_t> failed_{0};
+  std::atomic<std::uint64_t> refused_{0};
+  std::jthread thread_;  // last: started once everything it uses exists
 };
 
 }  // namespace rsg::gateway

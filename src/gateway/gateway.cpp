@@ -352,6 +352,8 @@ MetricsSnapshot Gateway::metrics_snapshot(const GatewayStats& stats, Clock::time
   MetricsSnapshot metrics;
   metrics.stats = stats;
   metrics.has_ingress = ingress_.has_value();
+  if (dump_writer_)
+    metrics.dumps = DumpCounts{dump_writer_->written(), dump_writer_->failed(), dump_writer_->refused()};
   metrics.link_last_change_s = link_last_change_s_;
   metrics.gateway = config_.name.empty() ? config_.partition : config_.name;
   metrics.partition = config_.partition;

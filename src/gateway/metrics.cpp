@@ -52,6 +52,9 @@ constexpr Family kEgressUnencodable{"rsg_egress_unencodable_total", Type::kCount
                                     "Egress samples that describe no valid frame"};
 constexpr Family kEgressSendFailed{"rsg_egress_send_failed_total", Type::kCounter,
                                    "Egress datagrams the socket refused"};
+constexpr Family kDumps{"rsg_flight_recorder_dumps_total", Type::kCounter,
+                        "Flight-recorder dumps by result: written, failed (the file could not be written) or "
+                        "refused (earlier dumps were still being written)"};
 constexpr Family kLinkUp{"rsg_link_up", Type::kGauge,
                          "1 while valid frames arrive within the link deadline, else 0"};
 constexpr Family kLinkChange{"rsg_link_last_change_timestamp_seconds", Type::kGauge,
@@ -86,6 +89,7 @@ constexpr std::array kFamilies = {&kBuildInfo,
                                   &kEgressSent,
                                   &kEgressUnencodable,
                                   &kEgressSendFailed,
+                                  &kDumps,
                                   &kLinkUp,
                                   &kLinkChange,
                                   &kRate,
@@ -240,6 +244,12 @@ std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<
   out.one(kEgressSent, stats.egress.frames_sent);
   out.one(kEgressUnencodable, stats.egress.unencodable);
   out.one(kEgressSendFailed, stats.egress.send_failed);
+  if (const auto& dumps = snapshot.dumps) {
+    out.family(kDumps);
+    out.sample(kDumps, dumps->written, "result=\"written\"");
+    out.sample(kDumps, dumps->failed, "result=\"failed\"");
+    out.sample(kDumps, dumps->refused, "result=\"refused\"");
+  }
 
   out.one(kLinkUp, stats.link_up ? 1 : 0);
   out.one(kLinkChange, snapshot.link_last_change_s);

@@ -5,6 +5,7 @@
 // the server's thread formats it when a scraper asks. Nothing here runs per frame.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -16,9 +17,17 @@
 namespace rsg::gateway {
 
 /// What one scrape reports: the gateway's counters as of the last status period or link change.
+/// The flight recorder's dumps since start, by how they ended (DumpWriter).
+struct DumpCounts {
+  std::uint64_t written = 0;
+  std::uint64_t failed = 0;   ///< the file could not be written
+  std::uint64_t refused = 0;  ///< not taken: earlier dumps were still being written
+};
+
 struct MetricsSnapshot {
   GatewayStats stats;
   bool has_ingress = false;
+  std::optional<DumpCounts> dumps;  ///< with a flight recorder (--pcap-ring)
   /// Unix time (s) of the last link change; the gateway's start before the first.
   double link_last_change_s = 0;
   /// The labels every series carries; an empty value leaves its label out.

@@ -33,6 +33,7 @@ MetricsSnapshot example() {
   stats.rate_hz = 999.5;
   stats.ingress_delay_us = 250;
   stats.ingress_delay_max_us = 1500;
+  snapshot.dumps = DumpCounts{4, 1, 2};
   return snapshot;
 }
 
@@ -70,6 +71,17 @@ TEST(Metrics, EachCounterOfTheSnapshotIsOneSampleWithTheGatewaysLabels) {
   EXPECT_EQ(values.at(series("rsg_ingress_delay_seconds")), "0.00025");
   EXPECT_EQ(values.at(series("rsg_ingress_delay_max_seconds")), "0.0015");
   EXPECT_EQ(values.at(series("rsg_build_info", R"(version="0.1.0",fastdds_version="2.9.1")")), "1");
+}
+
+// One series per result, zeros included, and the family only with a flight recorder.
+TEST(Metrics, FlightRecorderDumpsHaveOneSeriesPerResult) {
+  const auto values = samples(format_metrics(example(), std::nullopt));
+  EXPECT_EQ(values.at(series("rsg_flight_recorder_dumps_total", R"(result="written")")), "4");
+  EXPECT_EQ(values.at(series("rsg_flight_recorder_dumps_total", R"(result="failed")")), "1");
+  EXPECT_EQ(values.at(series("rsg_flight_recorder_dumps_total", R"(result="refused")")), "2");
+  MetricsSnapshot without = example();
+  without.dumps.reset();
+  EXPECT_EQ(format_metrics(without, std::nullopt).find("rsg_flight_recorder"), std::string::npos);
 }
 
 TEST(Metrics, InvalidFramesHaveOneSeriesPerSpecCategoryZerosIncluded) {

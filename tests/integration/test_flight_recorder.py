@@ -3,8 +3,10 @@ writes the last second of datagrams as a pcap file, and again on SIGUSR1. Read b
 (with rsg's dissector), the file holds exactly the newest datagrams the simulator sent (its own
 --pcap says which), oldest first, invalid ones included (a datagram longer than any frame cut to
 2137 bytes), spanning at most the configured second. A thread of its own writes the file: with that
-thread stopped (as on a hung disk) the gateway goes on publishing."""
+thread stopped (as on a hung disk) the gateway goes on publishing; /metrics counts each dump by
+how it ended (rsg_flight_recorder_dumps_total)."""
 
+import re
 import signal
 import subprocess
 import sys
@@ -12,6 +14,7 @@ import time
 from pathlib import Path
 
 from harness import check, main, read_json, wait_for, wait_for_stats, free_udp_port
+from metrics_support import free_tcp_port, http_get
 from thread_freeze import freeze_thread, thaw_thread, thread_named
 
 DISSECTOR = Path(__file__).resolve().parents[2] / "tools" / "wireshark" / "rsg_sendbuf.lua"
@@ -26,6 +29,13 @@ def read_capture(path):
                           capture_output=True, text=True, timeout=60)
     check(done.returncode == 0, f"tshark cannot read {path.name}: {done.stderr}")
     return [tuple(line.split("\t")) for line in done.stdout.splitlines()]
+
+
+def dump_counts(metrics_port):
+    """rsg_flight_recorder_dumps_total by result, from the gateway's /metrics."""
+    reply = http_get(metrics_port, "/metrics")
+    found = re.findall(r'^rsg_flight_recorder_dumps_total\{.*result="(\w+)"\} (\d+)$', reply[1] if reply else "", re.M)
+    return {result: int(value) for result, value in found}
 
 
 def stuck_dump_writer(h, gateway, stats, port, dumps):
@@ -65,8 +75,9 @@ def body(h):
     port = free_udp_port()
     dumps = h.dir / "dumps"
     dumps.mkdir()
+    metrics = free_tcp_port()
     gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", str(RATE),
-                               "--pcap-ring", "1", "--pcap-dir", str(dumps))
+                               "--pcap-ring", "1", "--pcap-dir", str(dumps), "--metrics", f"127.0.0.1:{metrics}")
     wait_for_stats(stats, lambda s: True, "the gateway to start")
     sent_capture = h.dir / "sent.pcap"
     status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", str(RATE), "--count",
@@ -80,6 +91,9 @@ def body(h):
     gateway.send_signal(signal.SIGUSR1)
     on_signal = wait_for(lambda: sorted(dumps.glob("*_signal.pcap")), "the dump on SIGUSR1")[0]
     stuck_dump_writer(h, gateway, stats, port, dumps)
+    # Every dump counted by how it ended: all written (the files in the folder), one refused.
+    wait_for(lambda: dump_counts(metrics) == {"written": len(list(dumps.glob("*.pcap"))), "failed": 0, "refused": 1},
+             f"rsg_flight_recorder_dumps_total to count the dumps (it says {dump_counts(metrics)})")
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
 
     # The ring keeps at most the longest frame of a datagram (2137 bytes), as the gateway reads it.
