@@ -13,17 +13,19 @@ DumpWriter::DumpWriter() : thread_([this](const std::stop_token& stop) { run(sto
 // std::jthread asks run() to stop and joins it; run() writes what is pending first.
 DumpWriter::~DumpWriter() = default;
 
-bool DumpWriter::post(FlightRecorder::Snapshot snapshot, std::string reason) {
+bool DumpWriter::has_room() {
+  const std::lock_guard lock(mutex_);
+  if (pending_.size() < kMaxPending) return true;
+  refused_.fetch_add(1, std::memory_order_relaxed);
+  return false;
+}
+
+void DumpWriter::enqueue(Pending pending) {
   {
     const std::lock_guard lock(mutex_);
-    if (pending_.size() >= kMaxPending) {
-      refused_.fetch_add(1, std::memory_order_relaxed);
-      return false;
-    }
-    pending_.push_back({std::move(snapshot), std::move(reason)});
+    pending_.push_back(std::move(pending));
   }
   posted_.notify_one();
-  return true;
 }
 
 void DumpWriter::run(const std::stop_token& stop) {

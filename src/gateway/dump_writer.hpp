@@ -9,6 +9,7 @@
 #include <deque>
 #include <mutex>
 #include <stop_token>
+#include <string>
 #include <thread>
 
 #include "flight_recorder.hpp"
@@ -29,9 +30,16 @@ class DumpWriter {
   DumpWriter(const DumpWriter&) = delete;
   DumpWriter& operator=(const DumpWriter&) = delete;
 
-  /// Queues `snapshot` (taken for `reason`) and returns at once; false, and nothing queued, when
-  /// kMaxPending dumps already wait.
-  bool post(FlightRecorder::Snapshot snapshot, std::string reason);
+  /// When fewer than kMaxPending dumps wait, calls `take` on the calling thread and queues the
+  /// FlightRecorder::Snapshot it returns (taken for `reason`), then returns at once; otherwise
+  /// returns false without calling `take`, so a refused dump costs no copy. One thread posts (the
+  /// ingress thread): room seen here cannot be used up before the snapshot is queued.
+  template <class Take>
+  bool post(std::string reason, Take&& take) {
+    if (!has_room()) return false;
+    enqueue({take(), std::move(reason)});
+    return true;
+  }
 
   /// Dumps written, failed and refused since start (any thread).
   std::uint64_t written() const { return written_.load(std::memory_order_relaxed); }
@@ -43,6 +51,8 @@ class DumpWriter {
     FlightRecorder::Snapshot snapshot;
     std::string reason;
   };
+  bool has_room();  // counts a refusal when not
+  void enqueue(Pending pending);
   void run(const std::stop_token& stop);
 
   std::mutex mutex_;

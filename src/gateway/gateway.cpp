@@ -313,7 +313,7 @@ void Gateway::dump_flight_recorder(std::string_view reason) {
     return;
   }
   // The copy here, the file on the dump writer's thread: this is the ingress thread.
-  if (!dump_writer_->post(std::move(*ingress_->flight_recorder_snapshot(reason)), std::string(reason)))
+  if (!dump_writer_->post(std::string(reason), [&] { return *ingress_->flight_recorder_snapshot(reason); }))
     spdlog::error("flight recorder ({}): not dumped, {} earlier dumps are still being written", reason,
                   DumpWriter::kMaxPending);
 }
