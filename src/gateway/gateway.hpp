@@ -42,8 +42,8 @@ class Gateway {
 
   /// Writes the first status and stats file, then receives, publishes and reports until `stop` is
   /// set, then writes the final status. Whenever `dump` (when given) is set, it clears it and
-  /// writes the flight recorder's pcap file. `observer` (when given) hears of the start, every
-  /// turn of the loop and every status period, on this thread.
+  /// hands a flight-recorder dump to the dump writer's thread. `observer` (when given) hears of
+  /// the start, every turn of the loop and every status period, on this thread.
   void run(const std::atomic<bool>& stop, std::atomic<bool>* dump = nullptr,
            LoopObserver* observer = nullptr);
 

@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
     const GatewayConfig config = read_config(config_file, flags_only, argc, argv);
     spdlog::set_level(spdlog::level::from_str(config.log_level));
     const rsg::gateway::GatewaySetup setup = rsg::gateway::prepare(config);
-    // SIGUSR1 writes the flight recorder's pcap file: the loop does it when it sees `dump`.
+    // SIGUSR1 asks for a flight-recorder dump: the loop takes it when it sees `dump`.
     std::atomic<bool> stop{false};
     std::atomic<bool> dump{false};
     const StopOnSignal signals([&stop] { stop = true; }, [&dump] { dump = true; });
