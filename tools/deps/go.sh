@@ -4,8 +4,8 @@
 # (github.com/foxglove/mcap/go/mcap). GOPATH lives under $DEPS_DIR; the module and build caches
 # too, unless RSG_CACHE_DIR names a cache the checkouts of this machine share (make sets it to
 # ~/.cache/rsg, as ccache's is ~/.cache/ccache: a fresh clone then builds the tool from the cache).
-# The tool is built again only when tools/deps/go/ changed. (The official `mcap` CLI module, github.com/foxglove/mcap/go/cli/mcap,
-# is not served by the proxy: docs/mcap-tested.md.)
+# The tool is built again only when tools/deps/go/ changed. (The official `mcap` CLI module,
+# github.com/foxglove/mcap/go/cli/mcap, is not served by the proxy: docs/mcap-tested.md.)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 deps_dir=${DEPS_DIR:-$PWD/.deps}

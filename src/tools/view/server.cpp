@@ -1,5 +1,6 @@
 #include "server.hpp"
 
+#include <pthread.h>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
@@ -394,7 +395,10 @@ Server::Server(const ServerOptions& options, std::vector<foxglove::Channel> chan
     throw EnvironmentError("cannot listen on " + options.host + ":" + std::to_string(options.port) + ": " +
                            listen_error.message());
   impl_->accept();
-  impl_->thread = std::thread([impl = impl_.get()] { impl->io.run(); });
+  impl_->thread = std::thread([impl = impl_.get()] {
+    ::pthread_setname_np(::pthread_self(), "rsg-view-http");  // CONTRIBUTING.md, Threads
+    impl->io.run();
+  });
 }
 
 Server::~Server() {
