@@ -7,19 +7,11 @@
 #include <stdexcept>
 
 #include "dds/internal/fastdds_compat.hpp"
+#include "dds/internal/rtps_guard.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::dds {
 namespace fdds = eprosima::fastdds::dds;
-
-Participant::Participant(int domain, const std::string& profile) {
-  auto* factory = fdds::DomainParticipantFactory::get_instance();
-  participant_ = profile.empty() ? factory->create_participant(domain, fdds::PARTICIPANT_QOS_DEFAULT)
-                                 : factory->create_participant_with_profile(domain, profile);
-  if (!participant_)
-    throw EnvironmentError("cannot create DDS participant on domain " + std::to_string(domain) +
-                           " with profile '" + profile + "' (are the XML profiles loaded?)");
-}
 
 namespace {
 
@@ -40,13 +32,19 @@ fdds::DomainParticipantQos with_discovery(fdds::DomainParticipantQos qos, int do
 
 }  // namespace
 
+Participant::Participant(int domain, const std::string& profile)
+    : Participant(domain, profile_qos(profile)) {}
+
 Participant::Participant(int domain, const std::string& profile, const DiscoveryOptions& discovery,
                          fdds::DomainParticipantListener* listener)
     : Participant(domain, with_discovery(profile_qos(profile), domain, discovery), listener) {}
 
 Participant::Participant(int domain, const fdds::DomainParticipantQos& qos,
                          fdds::DomainParticipantListener* listener) {
-  participant_ = fdds::DomainParticipantFactory::get_instance()->create_participant(domain, qos, listener,
+  fdds::DomainParticipantQos guarded = qos;
+  internal::guard_transports(guarded, guard_);
+  internal::bound_discovery(guarded);
+  participant_ = fdds::DomainParticipantFactory::get_instance()->create_participant(domain, guarded, listener,
                                                                                     fdds::StatusMask::none());
   if (!participant_)
     throw EnvironmentError("cannot create DDS participant on domain " + std::to_string(domain));

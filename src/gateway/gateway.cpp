@@ -354,6 +354,11 @@ MetricsSnapshot Gateway::metrics_snapshot(const GatewayStats& stats, Clock::time
   metrics.has_ingress = ingress_.has_value();
   if (dump_writer_)
     metrics.dumps = DumpCounts{dump_writer_->written(), dump_writer_->failed(), dump_writer_->refused()};
+  const dds::RtpsGuardCounts& guard = participant_.rtps_guard();
+  metrics.dds_guard = DdsGuardCounts{guard.statistics_removed.load(std::memory_order_relaxed),
+                                     guard.statistics_misplaced.load(std::memory_order_relaxed),
+                                     guard.send_channels_opened.load(std::memory_order_relaxed),
+                                     guard.destinations_skipped.load(std::memory_order_relaxed)};
   metrics.link_last_change_s = link_last_change_s_;
   metrics.gateway = config_.name.empty() ? config_.partition : config_.name;
   metrics.partition = config_.partition;

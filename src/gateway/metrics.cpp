@@ -55,6 +55,12 @@ constexpr Family kEgressSendFailed{"rsg_egress_send_failed_total", Type::kCounte
 constexpr Family kDumps{"rsg_flight_recorder_dumps_total", Type::kCounter,
                         "Flight-recorder dumps by result: written, failed (the file could not be written) or "
                         "refused (earlier dumps were still being written)"};
+constexpr Family kDdsGuard{
+    "rsg_dds_guard_total", Type::kCounter,
+    "What the DDS transport guard did: statistics_removed (the statistics submessage "
+    "Fast DDS peers put last in every message), statistics_misplaced (one anywhere else: "
+    "an attack), send_channel_opened (a reader locator Fast DDS had opened no channel for), "
+    "destination_skipped (no channel could be opened: not sent)"};
 constexpr Family kLinkUp{"rsg_link_up", Type::kGauge,
                          "1 while valid frames arrive within the link deadline, else 0"};
 constexpr Family kLinkChange{"rsg_link_last_change_timestamp_seconds", Type::kGauge,
@@ -90,6 +96,7 @@ constexpr std::array kFamilies = {&kBuildInfo,
                                   &kEgressUnencodable,
                                   &kEgressSendFailed,
                                   &kDumps,
+                                  &kDdsGuard,
                                   &kLinkUp,
                                   &kLinkChange,
                                   &kRate,
@@ -250,6 +257,11 @@ std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<
     out.sample(kDumps, dumps->failed, "result=\"failed\"");
     out.sample(kDumps, dumps->refused, "result=\"refused\"");
   }
+  out.family(kDdsGuard);
+  out.sample(kDdsGuard, snapshot.dds_guard.statistics_removed, "action=\"statistics_removed\"");
+  out.sample(kDdsGuard, snapshot.dds_guard.statistics_misplaced, "action=\"statistics_misplaced\"");
+  out.sample(kDdsGuard, snapshot.dds_guard.send_channels_opened, "action=\"send_channel_opened\"");
+  out.sample(kDdsGuard, snapshot.dds_guard.destinations_skipped, "action=\"destination_skipped\"");
 
   out.one(kLinkUp, stats.link_up ? 1 : 0);
   out.one(kLinkChange, snapshot.link_last_change_s);

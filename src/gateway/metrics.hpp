@@ -24,10 +24,19 @@ struct DumpCounts {
   std::uint64_t refused = 0;  ///< not taken: earlier dumps were still being written
 };
 
+/// What the transport guard of the gateway's participant did (rsg/dds/rtps_guard.hpp).
+struct DdsGuardCounts {
+  std::uint64_t statistics_removed = 0;
+  std::uint64_t statistics_misplaced = 0;
+  std::uint64_t send_channels_opened = 0;
+  std::uint64_t destinations_skipped = 0;
+};
+
 struct MetricsSnapshot {
   GatewayStats stats;
   bool has_ingress = false;
   std::optional<DumpCounts> dumps;  ///< with a flight recorder (--pcap-ring)
+  DdsGuardCounts dds_guard;
   /// Unix time (s) of the last link change; the gateway's start before the first.
   double link_last_change_s = 0;
   /// The labels every series carries; an empty value leaves its label out.

@@ -23,11 +23,14 @@ chroot=tools/fastdds3/chroot.sh
 logs=$build/test-fastdds3
 # The process tests that also run against 3.x: the pipeline, its errors and selections, a
 # data-sharing reader's history (late_joiner), rate topics, the demo, the embedded gateway, the
+# Fast DDS attacks, the
 # standard ROS 2 topics read by Cyclone, the CLI. Not the ones that need tshark or Node (pcap_replay,
 # replay_formats, flight_recorder; record.*, view.*), nor Debian's rosidl (ros2.rosidl_cyclone,
 # ros2.egress: run across below): the chroot has none of them.
 integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors|late_joiner"
 integration+="|rate_topic|demo|realtime_gateway|embedded_controller"
+# The Fast DDS attacks (3.1.2 as Debian 13 builds it aborts on both without rsg's guard).
+integration+="|dds_attacks"
 processes="views\.rsg_echo|interop\.cyclone|integration\.($integration)|ros2\.(standard_topics|msg_matches_field_table)"
 processes+="|gateway\.embedded|cli\.rsg_frame|packaging\.install_consumer"
 # rsg_record, rsg_replay and rsg_embedded_gateway complete what `cmake --install` installs, for

@@ -18,6 +18,11 @@ over loopback and the host's /dev/shm (what docker/compose.yaml sets).
                 the image's gateway run with --ros2 and the standard topics, read by a real rclpy
                 node (make deps' ROS 2 environment on the host): rosidl's RIHS01 type hash on each
                 of its five ROS 2 writers
+  dds_attacks   the image's gateway at 500 Hz with a reader, then the Fast DDS attacks of
+                tests/support/dds_attacks.py from the host (the 84-byte statistics datagram on every
+                port of the domain, two readers of the image on a unicast and a multicast locator,
+                3,000 random RTPS datagrams): it keeps running and publishing, every reader gets its
+                samples, rsg_dds_guard_total counts what its guard did
   compose       docker/compose.yaml's services, run as the file says (docker compose with Docker;
                 with podman by compose_up, as Debian 12's podman-compose cannot run the file): the
                 gateway healthy, the echo's samples, the page on RSG_VIEW_PORT, the recording in the
@@ -44,9 +49,15 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "integration"))
+sys.path.insert(0, str(ROOT / "tests" / "support"))
 from harness import (TestFailure, check, free_udp_port, read_json_lines, wait_for, wait_for_stats,  # noqa: E402
                      wait_reader_matched)
+from metrics_support import http_get, parse_samples, value_of  # noqa: E402
+from dds_attacks import (TWO_LOCATORS_PROFILE, TWO_LOCATORS_XML, guard_counts, one_datagram,  # noqa: E402
+                         random_datagrams, send_to_domain)
 
+# Where the image installs rsg's XML profiles (docker/Dockerfile: prefix /opt/rsg).
+IMAGE_PROFILES = "/opt/rsg/share/rsg/xml_profiles"
 SELECTIONS = ["--every", "1:q,dq,time", "--every", "3:g0", "--every", "10:all"]
 COUNT = 1000
 # Inside the image: the entrypoint's stats file (the HEALTHCHECK reads it) and where tests mount.
@@ -79,9 +90,9 @@ class Containers:
         # The entrypoint's --metrics 127.0.0.1:$RSG_METRICS_PORT, where the HEALTHCHECK asks /healthz:
         # a port of this run (the host network is shared with every other test's gateways).
         self.metrics_port = free_tcp_port()
-        # Domains 210-230: none of ctest's (tests/support/test_domain.py: 20-99), one per case, so that no
+        # Domains 210-233: none of ctest's (tests/support/test_domain.py: 20-99), one per case, so that no
         # other test's gateway and no earlier case's writer is matched.
-        self.domain = 210 + os.getpid() % 5 * 4 + sorted(CASES).index(case)
+        self.domain = 210 + os.getpid() % 3 * 8 + sorted(CASES).index(case)
         self.prefix = f"rsg-image-test-{os.getpid()}-{case.replace('_', '-')}"
         self.processes = {}
         self.names = set()
@@ -265,6 +276,52 @@ def health(c):
              timeout_s=60, interval_s=1)
     print("[image] health: unhealthy before the robot, healthy while it streams, unhealthy after it stopped; "
           "healthy without a gateway", flush=True)
+
+
+def dds_attacks(c):
+    port = free_udp_port()
+    gateway = c.gateway(port)
+    wait_for_stats(c.stats, lambda s: True, "the gateway container to start", timeout_s=60)
+    c.start("sim", "--to", f"127.0.0.1:{port}", "--rate", "500", "--duration", "120", entrypoint="rsg_sim")
+    plain = c.start("plain", "--domain", c.domain, "--json", "--timeout", "120", entrypoint="rsg_echo")
+    wait_for_stats(c.stats, lambda s: s["state_readers"] >= 1 and s["frames_published"] > 500,
+                   "a reader to match and frames to be published", timeout_s=60)
+
+    def alive_and_publishing(what):
+        check(gateway.poll() is None, f"the gateway container ended after {what}: {c.stderr('gateway')[-800:]}")
+        before = json.loads(c.stats.read_text())["frames_published"]
+        wait_for_stats(c.stats, lambda s: s["frames_published"] >= before + 500,
+                       f"the gateway to publish after {what}", timeout_s=30)
+
+    def guard():
+        reply = http_get(c.metrics_port, "/metrics")
+        check(reply is not None and reply[0] == 200, f"/metrics did not answer: {reply}")
+        return guard_counts(parse_samples(reply[1]), value_of)
+
+    send_to_domain(int(c.domain), [one_datagram()] * 3)
+    time.sleep(0.5)
+    alive_and_publishing("the 84-byte statistics datagram")
+    wait_for(lambda: guard()["statistics_misplaced"] >= 1,
+             "rsg_dds_guard_total to count the misplaced statistics submessage", timeout_s=30)
+
+    (c.data / "two_locators.xml").write_text(TWO_LOCATORS_XML)
+    for i in range(3):  # side by side: the second one to match is the one Fast DDS sends to unopened
+        c.start(f"two_locators{i}", "--domain", c.domain, "--json", "--count", "1000", "--timeout", "60",
+                "--profiles", IMAGE_PROFILES, "--profiles", f"{DATA}/two_locators.xml",
+                "--participant-profile", TWO_LOCATORS_PROFILE, entrypoint="rsg_echo")
+        time.sleep(0.7)
+    for i in range(3):
+        check(c.wait(f"two_locators{i}", 90) == 0,
+              f"reader {i} on two locators did not get 1000 samples: {c.stderr(f'two_locators{i}')[-500:]}")
+    alive_and_publishing("two readers on a unicast and a multicast locator")
+    wait_for(lambda: guard()["send_channel_opened"] >= 1, "rsg_dds_guard_total to count the opened send channel",
+             timeout_s=30)
+
+    send_to_domain(int(c.domain), random_datagrams(3000))
+    time.sleep(0.5)
+    alive_and_publishing("3,000 random RTPS datagrams")
+    check(plain.poll() is None, f"the plain reader ended: {c.stderr('plain')[-500:]}")
+    print(f"[image] dds_attacks: the gateway kept publishing; guard {guard()}", flush=True)
 
 
 def view_and_restart(c):
@@ -477,7 +534,7 @@ def ros2_type_hash(c):
 
 
 CASES = {"pipeline": pipeline, "health": health, "view_and_restart": view_and_restart, "compose": compose,
-         "ros2_type_hash": ros2_type_hash}
+         "ros2_type_hash": ros2_type_hash, "dds_attacks": dds_attacks}
 
 
 def main():

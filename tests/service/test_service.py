@@ -13,6 +13,10 @@ the ones before left:
                 systemd's StatusText is the gateway's STATUS= line
   frames        frames sent from the host arrive exact at rsg_echo --json on the host; the
                 gateway's "link up" is in the journal at priority info, not among the warnings
+  dds_attacks   (after upgrade) the Fast DDS attacks of tests/support/dds_attacks.py from the host (the 84-byte
+                statistics datagram on every port of the domain, two readers on a unicast and a
+                multicast locator, 3,000 random RTPS datagrams): the same process keeps running
+                (no restart), rsg_dds_guard_total counts what its guard did, frames arrive exact
   sigkill       the gateway killed with SIGKILL: systemd restarts it, and the same rsg_echo
                 receives the next frames exact
   watchdog      the gateway frozen with SIGSTOP: systemd's watchdog kills it ("Watchdog timeout" in
@@ -49,7 +53,11 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "integration"))
+sys.path.insert(0, str(ROOT / "tests" / "support"))
 from harness import TestFailure, check, free_udp_port, read_json_lines, wait_for  # noqa: E402
+from metrics_support import http_get, parse_samples, value_of  # noqa: E402
+from dds_attacks import (TWO_LOCATORS_PROFILE, TWO_LOCATORS_XML, guard_counts, one_datagram,  # noqa: E402
+                         random_datagrams, send_to_domain)
 
 UNIT = "rsg-gateway@robot1.service"
 BROKEN = "rsg-gateway@broken.service"
@@ -278,6 +286,60 @@ class Run:
         check("link up" in infos and "link up" not in warnings,
               f"'link up' is not an info line of the journal:\n{infos[-1500:]}\n-- warnings:\n{warnings[-1500:]}")
 
+    def dds_attacks(self):
+        pid = self.box.main_pid()
+        restarts = self.box.show(UNIT, "NRestarts")
+
+        def same_process(what):
+            check(self.box.main_pid() == pid and self.box.show(UNIT, "ActiveState") == "active",
+                  f"the gateway did not survive {what}:\n{self.box.journal(UNIT)[-2000:]}")
+            check(self.box.show(UNIT, "NRestarts") == restarts, f"systemd restarted the gateway after {what}")
+
+        def guard():
+            reply = http_get(self.metrics_port, "/metrics")
+            check(reply is not None and reply[0] == 200, f"/metrics did not answer: {reply}")
+            return guard_counts(parse_samples(reply[1]), value_of)
+
+        send_to_domain(self.domain, [one_datagram()] * 3)
+        time.sleep(0.5)
+        same_process("the 84-byte statistics datagram")
+        wait_for(lambda: guard()["statistics_misplaced"] >= 1, "rsg_dds_guard_total to count the misplaced statistics submessage",
+             timeout_s=30)
+
+        profile = self.dir / "two_locators.xml"
+        profile.write_text(TWO_LOCATORS_XML)
+        sim = subprocess.Popen([str(self.bin / "rsg_sim"), "--to", f"127.0.0.1:{self.port}", "--rate", str(RATE),
+                                "--duration", "60"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            readers = []
+            for i in range(3):  # side by side: the second one to match is the one Fast DDS sends to unopened
+                readers.append(subprocess.Popen(
+                    [str(self.bin / "rsg_echo"), "--domain", str(self.domain), "--partition", self.partition,
+                     "--json", "--count", "1000", "--timeout", "40", "--profiles", str(ROOT / "xml_profiles"),
+                     "--profiles", str(profile), "--participant-profile", TWO_LOCATORS_PROFILE],
+                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True))
+                time.sleep(0.7)
+            for i, reader in enumerate(readers):
+                _, err = reader.communicate(timeout=60)
+                check(reader.returncode == 0, f"reader {i} on two locators did not get 1000 samples: {err[-500:]}")
+        finally:
+            sim.terminate()
+            sim.wait()
+        same_process("two readers on a unicast and a multicast locator")
+        wait_for(lambda: guard()["send_channel_opened"] >= 1, "rsg_dds_guard_total to count the opened send channel",
+             timeout_s=30)
+
+        send_to_domain(self.domain, random_datagrams(3000))
+        time.sleep(0.5)
+        same_process("3,000 random RTPS datagrams")
+        # A fresh reader (the one of the steps before has finished): frames still arrive exact.
+        self.sent = []
+        self.start_echo(FRAMES)
+        self.wait_matched(0)
+        self.send_and_check("dds_attacks")
+        check(self.echo.wait(timeout=60) == 0, f"rsg_echo exited non-zero: {self.echo_err.read_text()[-500:]}")
+        print(f"[service] dds_attacks: pid {pid} kept running, no restart; guard {guard()}", flush=True)
+
     def sigkill(self):
         pid = self.box.main_pid()
         restarts = int(self.box.show(UNIT, "NRestarts"))
@@ -394,7 +456,8 @@ class Run:
         subprocess.run(["fastdds", "shm", "clean"], capture_output=True)
 
 
-STEPS = ["install", "ready", "frames", "sigkill", "watchdog", "upgrade", "ros2_type_hash", "broken", "purge"]
+STEPS = ["install", "ready", "frames", "sigkill", "watchdog", "upgrade", "dds_attacks", "ros2_type_hash", "broken",
+         "purge"]
 
 
 def main():

@@ -5,7 +5,9 @@
 //   auto* writer = participant.publisher({"robot1"})->create_datawriter_with_profile(topic,
 //   "rsg_state_writer");
 //
-// Entities are deleted, contained ones first, when the Participant goes out of scope.
+// Entities are deleted, contained ones first, when the Participant goes out of scope. Its UDP
+// transports sit behind rsg's guard (rsg/dds/rtps_guard.hpp): no datagram and no peer can make
+// Fast DDS abort it.
 #pragma once
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -14,10 +16,12 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "rsg/dds/discovery.hpp"
+#include "rsg/dds/rtps_guard.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::dds {
@@ -46,6 +50,9 @@ class Participant {
 
   eprosima::fastdds::dds::DomainParticipant* get() const { return participant_; }
 
+  /// What the transport guard did so far (for the gateway's /metrics).
+  const RtpsGuardCounts& rtps_guard() const { return *guard_; }
+
   /// Registers `RobotState` (with its type object, which content filters need) and returns the
   /// topic of that name, creating it once. Type information is not sent in discovery: Cyclone DDS
   /// 0.10 silently drops samples of writers that announce it.
@@ -61,6 +68,7 @@ class Participant {
   eprosima::fastdds::dds::Subscriber* subscriber(const std::vector<std::string>& partitions = {});
 
  private:
+  std::shared_ptr<RtpsGuardCounts> guard_ = std::make_shared<RtpsGuardCounts>();
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
 };
 

@@ -1,0 +1,110 @@
+"""No packet and no DDS peer can take the gateway down (docs/fastdds-versions.md, "What no packet can do").
+
+Against a gateway fed at 1 kHz with a reader attached, on loopback (tests/support/dds_attacks.py):
+  1. the 84-byte datagram with a misplaced eProsima statistics submessage that aborts every Fast DDS
+     2.9.1 / 3.1.2 process Debian builds, sent to every port a participant of the domain listens on;
+  2. two readers whose participant announces a unicast and a multicast user locator (a legal
+     profile), on which Fast DDS 2.9.1 / 3.1.2 abort in OutputTrafficManager::set_statistics_message_data;
+  3. 3,000 random RTPS datagrams with statistics submessages anywhere;
+  4. 2,000 announcements of made-up participants, each with the longest lease: the gateway keeps
+     at most kMaxRemoteParticipants (256) of them (src/dds/internal/rtps_guard.hpp; Fast DDS's
+     default keeps every one, never freed): a participant announced after them is not answered,
+     the readers matched before keep their samples, and its memory stays bounded.
+After each the gateway must still run and publish, every reader get its samples, and
+rsg_dds_guard_total on /metrics say what the guard did."""
+
+import sys
+import time
+from pathlib import Path
+
+from harness import check, main, read_json, wait_for, wait_for_stats, free_udp_port
+from metrics_support import free_tcp_port, http_get, parse_samples, value_of
+from dds_attacks import (TWO_LOCATORS_PROFILE, TWO_LOCATORS_XML, answers_new_participant, guard_counts,
+                         one_datagram, random_datagrams, send_to_domain, spoof_participants, udp_ports_of)
+
+# Made-up participants announced to the gateway's own ports, 8 times the 256 it keeps; what they may
+# add to its resident memory: the 256, the datagrams' transient buffers and the allocator's slack.
+SPOOFED = 2000
+SPOOF_RSS_GROWTH_LIMIT_KB = 8 * 1024
+
+PROFILES = Path(__file__).resolve().parents[2] / "xml_profiles"
+
+
+def scrape_guard(metrics_port):
+    reply = http_get(metrics_port, "/metrics")
+    check(reply is not None and reply[0] == 200, f"/metrics did not answer: {reply}")
+    return guard_counts(parse_samples(reply[1]), value_of)
+
+
+def resident_kb(pid):
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1])
+    raise AssertionError(f"no VmRSS for {pid}")
+
+
+def check_alive_and_publishing(gateway, stats, what):
+    check(gateway.poll() is None, f"the gateway died after {what} (exit {gateway.returncode})")
+    before = read_json(stats)["frames_published"]
+    wait_for_stats(stats, lambda s: s["frames_published"] >= before + 500, f"the gateway to publish after {what}")
+
+
+def body(h):
+    port, metrics_port = free_udp_port(), free_tcp_port()
+    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000",
+                               "--metrics", f"127.0.0.1:{metrics_port}")
+    wait_for_stats(stats, lambda s: True, "the gateway to start")
+    h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--duration", "50"])
+    plain = h.start("plain", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic", "robot_state",
+                              "--json", "--timeout", "55"])
+    wait_for_stats(stats, lambda s: s["state_readers"] >= 1 and s["frames_published"] > 500,
+                   "a reader to match and frames to be published")
+
+    send_to_domain(h.domain, [one_datagram()] * 3)
+    time.sleep(0.5)
+    check_alive_and_publishing(gateway, stats, "the 84-byte statistics datagram")
+    wait_for(lambda: scrape_guard(metrics_port)["statistics_misplaced"] >= 1,
+             "rsg_dds_guard_total to count the misplaced statistics submessage")
+
+    profile = h.dir / "two_locators.xml"
+    profile.write_text(TWO_LOCATORS_XML)
+    readers = []
+    for i in range(3):  # side by side: the second one to match is the one Fast DDS sends to unopened
+        readers.append(h.start(f"two_locators{i}", [h.binary("rsg_echo"), "--domain", str(h.domain), "--topic",
+                                                    "robot_state", "--json", "--count", "1000", "--timeout", "30",
+                                                    "--profiles", str(PROFILES), "--profiles", str(profile),
+                                                    "--participant-profile", TWO_LOCATORS_PROFILE]))
+        time.sleep(0.7)
+    for i, reader in enumerate(readers):
+        check(h.wait(f"two_locators{i}", reader, 40) == 0, f"reader {i} on two locators did not get 1000 samples")
+    check_alive_and_publishing(gateway, stats, "two readers on a unicast and a multicast locator")
+    wait_for(lambda: scrape_guard(metrics_port)["send_channel_opened"] >= 1,
+             "rsg_dds_guard_total to count the send channel the guard opened")
+
+    send_to_domain(h.domain, random_datagrams(3000))
+    time.sleep(0.5)
+    check_alive_and_publishing(gateway, stats, "3,000 random RTPS datagrams")
+    print(f"[dds_attacks] guard: {scrape_guard(metrics_port)}", flush=True)
+
+    gateway_ports = udp_ports_of(gateway.pid)
+    check(answers_new_participant(h.domain, free_udp_port(), gateway_ports),
+          "the gateway did not answer a new participant before the spoofing")
+    before_kb = resident_kb(gateway.pid)
+    spoof_participants(h.domain, SPOOFED, gateway_ports)
+    time.sleep(1.0)
+    check(not answers_new_participant(h.domain, free_udp_port(), gateway_ports),
+          f"the gateway still takes new participants after {SPOOFED} spoofed ones: its limit is not in force")
+    check_alive_and_publishing(gateway, stats, f"{SPOOFED} spoofed participant announcements")
+    growth_kb = resident_kb(gateway.pid) - before_kb
+    print(f"[dds_attacks] {SPOOFED} spoofed participants: resident memory {before_kb} kB + {growth_kb} kB", flush=True)
+    check(growth_kb < SPOOF_RSS_GROWTH_LIMIT_KB,
+          f"{SPOOFED} spoofed participants grew the gateway by {growth_kb} kB (limit {SPOOF_RSS_GROWTH_LIMIT_KB} kB)")
+
+    check(plain.poll() is None, f"the plain reader stopped (exit {plain.returncode})")
+    lines = h.output("plain").read_text().count("\n")
+    check(lines > 1000, f"the plain reader printed only {lines} samples")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+
+
+if __name__ == "__main__":
+    sys.exit(main("dds_attacks", body))
