@@ -1,19 +1,27 @@
-# Source me (bash or zsh): the project-local ROS 2 Kilted that `make deps` installs.
+# Source me (bash or zsh): a project-local ROS 2 that `make deps` installs, Kilted or Jazzy.
 #
-#   . ros2/env.sh
+#   . ros2/env.sh                        # ROS 2 Kilted (Fast DDS 3.2), the default
+#   RSG_ROS_DISTRO=jazzy . ros2/env.sh   # ROS 2 Jazzy LTS (Fast DDS 2.14)
 #   python -c 'import rclpy; from rsg_msgs.msg import RobotState'
 #
-# .deps/ros2            the Python environment of the ROS 2 wheels (tools/deps/python/ros2.txt):
-#                       rclpy, rmw_fastrtps_cpp on Fast DDS 3.2, std/sensor/geometry_msgs, rosidl
-# .deps/ros2_ws/install rsg_msgs (ros2/rsg_msgs) and tf2_msgs (tests/ros2/tf2_msgs) built by
-#                       ament_cmake + rosidl from those wheels (tools/deps/ros2_ws.sh)
+#                 Kilted                Jazzy
+# wheels          .deps/ros2            .deps/ros2-jazzy          the Python environment of the ROS 2
+#                                                                 wheels (tools/deps/python/ros2.txt,
+#                                                                 ros2-jazzy.txt): rclpy,
+#                                                                 rmw_fastrtps_cpp, std/sensor/
+#                                                                 geometry_msgs, rosidl
+# workspace       .deps/ros2_ws/install .deps/ros2_ws-jazzy/install  rsg_msgs (ros2/rsg_msgs) and
+#                                                                 tf2_msgs (tests/ros2/tf2_msgs) built
+#                                                                 by that distribution's ament_cmake
+#                                                                 + rosidl (tools/deps/ros2_ws.sh)
 #
 # The wheels put their libraries in the environment's lib/ and in site-packages/ros_*.libs and
 # find packages through the ament index: this sets PATH, LD_LIBRARY_PATH, PYTHONPATH,
-# AMENT_PREFIX_PATH, CMAKE_PREFIX_PATH and RMW_IMPLEMENTATION=rmw_fastrtps_cpp. It also tells the
-# wheels' own start-up hook (ros_wheels_bootstrapper, which re-executes Python once to set
+# AMENT_PREFIX_PATH, CMAKE_PREFIX_PATH, ROS_DISTRO and RMW_IMPLEMENTATION=rmw_fastrtps_cpp. It also
+# tells the wheels' own start-up hook (ros_wheels_bootstrapper, which re-executes Python once to set
 # LD_LIBRARY_PATH) that this is done. ROS_DOMAIN_ID is left as it is: use the gateway's --domain.
-# Another environment: RSG_DEPS_DIR=/path/to/.deps before sourcing.
+# Another environment: RSG_DEPS_DIR=/path/to/.deps before sourcing. Source it in a fresh shell to
+# change distribution: the two sets of libraries must not both be on LD_LIBRARY_PATH.
 
 if [ -n "${BASH_SOURCE:-}" ]; then
   _rsg_ros2_here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
@@ -21,12 +29,22 @@ else
   _rsg_ros2_here=$(cd "$(dirname "$0")" && pwd)  # zsh sets $0 to the sourced file
 fi
 _rsg_deps=${RSG_DEPS_DIR:-$(dirname "$_rsg_ros2_here")/.deps}
-export RSG_ROS2_VENV=$_rsg_deps/ros2
-export RSG_ROS2_INSTALL=$_rsg_deps/ros2_ws/install
+case ${RSG_ROS_DISTRO:-kilted} in
+  kilted) _rsg_suffix= ;;
+  jazzy) _rsg_suffix=-jazzy ;;
+  *)
+    echo "ros2/env.sh: RSG_ROS_DISTRO=$RSG_ROS_DISTRO: make deps installs kilted (the default) and jazzy" >&2
+    unset _rsg_ros2_here _rsg_deps
+    return 1 2>/dev/null || exit 1
+    ;;
+esac
+export RSG_ROS_DISTRO=${RSG_ROS_DISTRO:-kilted}
+export RSG_ROS2_VENV=$_rsg_deps/ros2$_rsg_suffix
+export RSG_ROS2_INSTALL=$_rsg_deps/ros2_ws$_rsg_suffix/install
 
 if [ ! -x "$RSG_ROS2_VENV/bin/python" ] || [ ! -d "$RSG_ROS2_INSTALL/share/rsg_msgs" ]; then
-  echo "ros2/env.sh: no ROS 2 environment in $_rsg_deps (ros2, ros2_ws/install): run make deps" >&2
-  unset _rsg_ros2_here _rsg_deps
+  echo "ros2/env.sh: no ROS 2 $RSG_ROS_DISTRO environment in $_rsg_deps (ros2$_rsg_suffix, ros2_ws$_rsg_suffix/install): run make deps" >&2
+  unset _rsg_ros2_here _rsg_deps _rsg_suffix
   return 1 2>/dev/null || exit 1
 fi
 
@@ -43,7 +61,7 @@ export PYTHONPATH=$RSG_ROS2_INSTALL/${_rsg_site#"$RSG_ROS2_VENV"/}${PYTHONPATH:+
 export AMENT_PREFIX_PATH=$RSG_ROS2_INSTALL:$RSG_ROS2_VENV
 export CMAKE_PREFIX_PATH=$RSG_ROS2_INSTALL:$RSG_ROS2_VENV${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}
 export RMW_IMPLEMENTATION=rmw_fastrtps_cpp
-export ROS_DISTRO=kilted ROS_VERSION=2 ROS_PYTHON_VERSION=3
+export ROS_DISTRO=$RSG_ROS_DISTRO ROS_VERSION=2 ROS_PYTHON_VERSION=3
 export _ROS_WHEELS_BOOTSTRAP_COMPLETE=1
 
-unset _rsg_ros2_here _rsg_deps _rsg_site _rsg_libs _rsg_dir
+unset _rsg_ros2_here _rsg_deps _rsg_suffix _rsg_site _rsg_libs _rsg_dir

@@ -51,12 +51,19 @@
 #         cost of one scrape (from 100 scrapes a second), alternating, over several rounds:
 #         bench/metrics/metrics_cost.json. About 5 minutes.
 #         RSG_BENCH_METRICS_ROUNDS    rounds (default 4), RSG_BENCH_METRICS_SECONDS window (default 20)
+#   ros2_rate  what a plain rclpy subscriber (default reliable QoS) on ROS 2 Jazzy and on Kilted
+#         receives from rsg_gateway --ros2 fed at 1 kHz, next to a plain rclpy publisher at 1 kHz of
+#         the same distribution (the floor): rate, lost, inter-arrival p50/p99/max, the
+#         subscriber's CPU (tests/bench/ros2_rate/ros2_rate.py, make deps' ROS 2 environments):
+#         bench/ros2_rate/ (ros2_rate.json, ros2_rate.md). About 5 minutes.
+#         RSG_BENCH_ROS2_RATE_SECONDS  measuring window per run (default 60)
+#         RSG_BENCH_ROS2_RATE_DISTROS  distributions (default jazzy,kilted)
 #
 # A suite is a function run_<suite> that writes its results under $out and a function
 # report_<suite> that prints them, plus its name in SUITES.
 set -euo pipefail
 
-SUITES=(wire e2e record scale late_join readers churn dumps metrics)
+SUITES=(wire e2e record scale late_join readers churn dumps metrics ros2_rate)
 
 here=$(cd "$(dirname "$0")" && pwd)
 usage() { echo "usage: $0 BUILD_DIR [${SUITES[*]}]" >&2; exit 2; }
@@ -186,6 +193,14 @@ run_metrics() {
     --seconds "${RSG_BENCH_METRICS_SECONDS:-20}" > "$out/metrics.txt"
 }
 report_metrics() { sed -n '/^###/,$p' "$out/metrics.txt"; }
+
+run_ros2_rate() {
+  RSG_DEPS_DIR=$(sed -n 's/^RSG_DEPS_DIR:PATH=//p' "$build/CMakeCache.txt") \
+    python3 "$here/ros2_rate/ros2_rate.py" --bin "$build/bin" --out "$out/ros2_rate" \
+    --seconds "${RSG_BENCH_ROS2_RATE_SECONDS:-60}" --distros "${RSG_BENCH_ROS2_RATE_DISTROS:-jazzy,kilted}" \
+    > "$out/ros2_rate.txt"
+}
+report_ros2_rate() { cat "$out/ros2_rate/ros2_rate.md"; }
 
 for suite in "${selected[@]}"; do
   declare -F "run_$suite" >/dev/null || { echo "$0: unknown suite '$suite'" >&2; usage; }

@@ -1,6 +1,8 @@
 """What the rclpy tests share: the project's ROS 2 environment (make deps: .deps/ros2 and
-.deps/ros2_ws/install, set up by ros2/env.sh), starting rclpy_peer.py in it, and rsg_sim's canonical
-JSON as the RobotState message a ROS 2 node must see.
+.deps/ros2_ws/install for Kilted, .deps/ros2-jazzy and .deps/ros2_ws-jazzy/install for Jazzy, set up
+by ros2/env.sh), starting rclpy_peer.py in it, and rsg_sim's canonical JSON as the RobotState message
+a ROS 2 node must see. The distribution is RSG_ROS_DISTRO's (kilted when unset), as for ros2/env.sh:
+ctest registers each rclpy test once per distribution (tests/ros2/CMakeLists.txt).
 
 The tests themselves run under any Python 3 (ctest's); only rclpy_peer.py runs in the ROS 2
 environment, on the test's DDS domain (ROS_DOMAIN_ID = the gateway's --domain).
@@ -22,18 +24,22 @@ class RosEnv:
     """The variables ros2/env.sh sets, read once; fails naming `make deps` when they are missing
     or when the workspace was built from other .msg files than the repository's."""
 
-    def __init__(self, domain):
+    def __init__(self, domain, distro=None):
         deps = os.environ.get("RSG_DEPS_DIR") or str(REPO / ".deps")
+        self.distro = distro or os.environ.get("RSG_ROS_DISTRO") or "kilted"
         shell = subprocess.run(["bash", "-c", f'. "{REPO}/ros2/env.sh" > /dev/null && env -0'],
-                               env={**os.environ, "RSG_DEPS_DIR": deps}, capture_output=True)
+                               env={**os.environ, "RSG_DEPS_DIR": deps, "RSG_ROS_DISTRO": self.distro},
+                               capture_output=True)
         check(shell.returncode == 0,
-              f"no ROS 2 environment in {deps} (the ROS 2 Kilted wheels and the rsg_msgs/tf2_msgs workspace): "
-              f"run `make deps` ({shell.stderr.decode().strip()})")
+              f"no ROS 2 {self.distro} environment in {deps} (the ROS 2 {self.distro} wheels and the "
+              f"rsg_msgs/tf2_msgs workspace): run `make deps` ({shell.stderr.decode().strip()})")
         variables = dict(item.split("=", 1) for item in shell.stdout.decode().split("\0") if "=" in item)
         keep = ("PATH", "LD_LIBRARY_PATH", "PYTHONPATH", "AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH", "RMW_IMPLEMENTATION",
                 "ROS_DISTRO", "ROS_VERSION", "ROS_PYTHON_VERSION", "_ROS_WHEELS_BOOTSTRAP_COMPLETE", "RSG_ROS2_VENV",
-                "RSG_ROS2_INSTALL")
+                "RSG_ROS2_INSTALL", "RSG_ROS_DISTRO")
         self.vars = {key: variables[key] for key in keep if key in variables}
+        check(self.vars.get("ROS_DISTRO") == self.distro,
+              f"ros2/env.sh set ROS_DISTRO={self.vars.get('ROS_DISTRO')} for RSG_ROS_DISTRO={self.distro}")
         self.vars["ROS_DOMAIN_ID"] = str(domain)
         self.vars["ROS_LOG_DIR"] = os.environ.get("TMPDIR", "/tmp")
         self.python = str(Path(self.vars["RSG_ROS2_VENV"]) / "bin" / "python")
@@ -50,9 +56,13 @@ class RosEnv:
     def argv(self, *args):
         """argv running rclpy_peer.py the way a user would: ros2/env.sh sourced, ROS_DOMAIN_ID set
         (the harness starts children with the test's own environment)."""
-        return ["env", f"ROS_DOMAIN_ID={self.domain}", f"RSG_DEPS_DIR={self.deps}",
+        return self.script_argv(PEER, *args)
+
+    def script_argv(self, script, *args):
+        """The same for another script meant for the ROS 2 environment (make bench's rate_peer.py)."""
+        return ["env", f"ROS_DOMAIN_ID={self.domain}", f"RSG_DEPS_DIR={self.deps}", f"RSG_ROS_DISTRO={self.distro}",
                 f"ROS_LOG_DIR={self.vars['ROS_LOG_DIR']}",
-                "bash", "-c", '. "$0" && exec python "$@"', str(REPO / "ros2/env.sh"), str(PEER), *map(str, args)]
+                "bash", "-c", '. "$0" && exec python "$@"', str(REPO / "ros2/env.sh"), str(script), *map(str, args)]
 
     def type_hash(self, package, name):
         """The RIHS01 hash rosidl's type-description generator computed for package/msg/name."""

@@ -37,8 +37,59 @@ from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityP
 
 try:
     from rclpy.subscription_content_filter_options import ContentFilterOptions
-except ImportError:  # pragma: no cover - rclpy before Humble
+except ImportError:  # Jazzy's rclpy (7.1) has no content filter API: rcl's C API, below
     ContentFilterOptions = None
+
+
+def filter_options(expression, parameters=()):
+    """create_subscription's keyword arguments for a content filter, where rclpy has the API (Kilted)."""
+    if expression is None or ContentFilterOptions is None:
+        return {}
+    return {"content_filter_options": ContentFilterOptions(filter_expression=expression,
+                                                           expression_parameters=list(parameters))}
+
+
+def set_rcl_content_filter(subscription, expression, parameters=()):
+    """Where rclpy has no content filter API (Jazzy's rclpy 7.1), the one rcl has had since Humble,
+    the one rclcpp uses: rcl_subscription_set_content_filter on the subscription's rcl handle, right
+    after it was created (before spinning: rmw_fastrtps puts a new, filtered DataReader in place of
+    the first, before discovery has matched it). Returns whether rcl reports the filter enabled."""
+    import ctypes
+    rcl = ctypes.CDLL("librcl.so")  # the wheels' (ros2/env.sh: LD_LIBRARY_PATH)
+    for name, argtypes in (("rcl_subscription_content_filter_options_init",
+                            [ctypes.c_void_p, ctypes.c_char_p, ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p]),
+                           ("rcl_subscription_set_content_filter", [ctypes.c_void_p, ctypes.c_void_p]),
+                           ("rcl_subscription_content_filter_options_fini", [ctypes.c_void_p, ctypes.c_void_p]),
+                           ("rcl_subscription_is_cft_enabled", [ctypes.c_void_p])):
+        getattr(rcl, name).argtypes = argtypes
+    rcl.rcl_subscription_is_cft_enabled.restype = ctypes.c_bool
+    handle = subscription.handle.pointer  # the rcl_subscription_t
+    # rcl_subscription_content_filter_options_t (a string and an rcutils string array with its
+    # allocator: 64 bytes on x86_64), zero-initialized as rcl_get_zero_initialized_... returns it.
+    options = ctypes.create_string_buffer(256)
+    params = (ctypes.c_char_p * max(1, len(parameters)))(*[p.encode() for p in parameters])
+    if rcl.rcl_subscription_content_filter_options_init(handle, expression.encode(), len(parameters), params, options):
+        return False
+    try:
+        if rcl.rcl_subscription_set_content_filter(handle, options):
+            return False
+    finally:
+        rcl.rcl_subscription_content_filter_options_fini(handle, options)
+    return bool(rcl.rcl_subscription_is_cft_enabled(handle))
+
+
+def create_filtered_subscription(node, cls, topic, callback, qos, expression=None, parameters=(), **kwargs):
+    """node.create_subscription with a content filter (None: none), by rclpy's API or by rcl's."""
+    subscription = node.create_subscription(cls, topic, callback, qos, **kwargs, **filter_options(expression, parameters))
+    if expression is not None and ContentFilterOptions is None:
+        subscription.rsg_cft_enabled = set_rcl_content_filter(subscription, expression, parameters)
+    return subscription
+
+
+def cft_enabled(subscription):
+    if hasattr(subscription, "rsg_cft_enabled"):
+        return subscription.rsg_cft_enabled
+    return subscription.is_cft_enabled
 
 
 def message_class(name):
@@ -109,18 +160,12 @@ def subscribe(args):
     def on_matched(info):
         say(f"matched {info.current_count}")
 
-    options = {}
+    subscription = create_filtered_subscription(node, cls, args.topic, on_message, qos_of(args), args.filter, args.param,
+                                                event_callbacks=SubscriptionEventCallbacks(matched=on_matched))
     if args.filter is not None:
-        if ContentFilterOptions is None:
-            say("refused: this rclpy has no content filter options")
-            return 3
-        options["content_filter_options"] = ContentFilterOptions(filter_expression=args.filter,
-                                                                 expression_parameters=args.param)
-    subscription = node.create_subscription(cls, args.topic, on_message, qos_of(args),
-                                            event_callbacks=SubscriptionEventCallbacks(matched=on_matched), **options)
-    if args.filter is not None:
-        say(f"content filter enabled: {subscription.is_cft_enabled}")
-        if not subscription.is_cft_enabled:
+        enabled = cft_enabled(subscription)
+        say(f"content filter enabled: {enabled}" + ("" if ContentFilterOptions else " (through rcl's C API)"))
+        if not enabled:
             say("refused: rmw did not enable the content filter")
             return 3
     deadline = time.monotonic() + args.timeout
@@ -200,10 +245,6 @@ def churn(args):
         def on_matched(info, matched=matched):
             matched[0] = info.current_count
 
-        options = {}
-        if args.filter:
-            options["content_filter_options"] = ContentFilterOptions(filter_expression=args.filter,
-                                                                     expression_parameters=[])
 
         def on_message(message, got=got):
             if args.filter and not all(message.group_present[int(term.split("[")[1].split("]")[0])]
@@ -211,8 +252,8 @@ def churn(args):
                 wrong[0] += 1
             got.set()
 
-        node.create_subscription(RobotState, args.topic, on_message, QoSProfile(depth=10),
-                                 event_callbacks=SubscriptionEventCallbacks(matched=on_matched), **options)
+        create_filtered_subscription(node, RobotState, args.topic, on_message, QoSProfile(depth=10), args.filter or None,
+                                     event_callbacks=SubscriptionEventCallbacks(matched=on_matched))
         executor = rclpy.executors.SingleThreadedExecutor(context=context)
         executor.add_node(node)
         deadline = time.monotonic() + args.hold
@@ -229,14 +270,12 @@ def churn(args):
 def hold(args):
     from rsg_msgs.msg import RobotState  # noqa: the held subscriptions read the gateway's state
     node = rclpy.create_node("rsg_bench_hold")
-    options = {}
-    if args.filter:
-        options["content_filter_options"] = ContentFilterOptions(filter_expression=args.filter, expression_parameters=[])
     qos = qos_profile_sensor_data if args.best_effort else QoSProfile(depth=10)
-    subscriptions = [node.create_subscription(RobotState, args.topic, lambda message: None, qos, **options)
+    subscriptions = [create_filtered_subscription(node, RobotState, args.topic, lambda message: None, qos,
+                                                  args.filter or None)
                      for _ in range(args.count)]
     say(f"holding {len(subscriptions)} subscriptions, content filter "
-        f"{all(s.is_cft_enabled for s in subscriptions) if args.filter else 'none'}")
+        f"{all(cft_enabled(s) for s in subscriptions) if args.filter else 'none'}")
     time.sleep(args.seconds)
     return 0
 

@@ -2,7 +2,7 @@
 crashes, stalls or loses a frame for its other readers.
 
 rsg_gateway --ros2 gets 3000 frames from rsg_sim at 200 Hz (15 s). Meanwhile one process runs 50
-times: rclpy.init (a new Fast DDS 3.2 participant), a node with a default-QoS RobotState subscription,
+times: rclpy.init (a new participant: Fast DDS 3.2 on Kilted, 2.14 on Jazzy), a node with a default-QoS RobotState subscription,
 wait until it matched and got a message, shutdown (the participant leaves); and three more rclpy
 subscribers are killed with SIGKILL (they vanish without saying goodbye: the gateway learns of it by
 lease expiry). A reliable keep-all rclpy subscription that stays all along gets every frame, in
@@ -91,7 +91,7 @@ def body(h):
     check(final["frames_published"] == COUNT and final["publish_failed"] == 0,
           f"published {final['frames_published']}, failed {final['publish_failed']}")
     # Every node has left now (the steady one after its last message); the killed ones only when
-    # their lease (Fast DDS 3.2's default: 20 s) ran out.
+    # their lease (Fast DDS's default, 20 s in 2.14 and 3.2) ran out.
     wait_for_stats(stats, lambda s: s["state_readers"] == 0, "the gateway to count no state reader once every node "
                    "left", timeout_s=40)
     check(gateway.poll() is None, "the gateway died")

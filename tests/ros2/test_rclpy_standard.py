@@ -1,6 +1,6 @@
 """The standard ROS 2 topics of rsg_gateway --ros2 (--joint-states, --tf, --external-wrench) read by
 real ROS 2 nodes: rclpy subscriptions of sensor_msgs/msg/JointState and geometry_msgs/msg/WrenchStamped
-(the Kilted wheels) and tf2_msgs/msg/TFMessage (built by rosidl from ROS 2's public definition in
+(the wheels of the distribution under test, RSG_ROS_DISTRO) and tf2_msgs/msg/TFMessage (built by rosidl from ROS 2's public definition in
 make deps' workspace), on rmw_fastrtps_cpp.
 
 In /robot1, fed by rsg_sim at 500 Hz: JointState at 100 Hz on /robot1/joint_states (name =
