@@ -60,7 +60,7 @@ def subscribe(args):
         return 1
     numbers = [n for _, n in window]
     unique = set(numbers)
-    span = max(numbers) - min(numbers) + 1
+    span = (max(numbers) - min(numbers)) // args.step + 1
     gaps = sorted((b - a) / 1e6 for (a, _), (b, _) in zip(window, window[1:]))
     print(json.dumps({
         "received": len(window), "seconds": args.seconds, "rate_hz": round(len(window) / args.seconds, 1),
@@ -117,6 +117,7 @@ def main():
     sub.add_argument("--settle", type=float, default=3)
     sub.add_argument("--seconds", type=float, default=60)
     sub.add_argument("--timeout", type=float, default=60, help="for the first message")
+    sub.add_argument("--step", type=int, default=1, help="`time` between two frames [ms]: 1 at 1 kHz")
     pub = commands.add_parser("pub")
     pub.add_argument("--topic", default="/robot_state")
     pub.add_argument("--rate", type=float, default=1000)

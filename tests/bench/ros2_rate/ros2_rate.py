@@ -3,6 +3,7 @@ rsg_gateway --ros2 at 1 kHz, on ROS 2 Jazzy and on ROS 2 Kilted, next to the flo
 publisher at 1 kHz to the same subscriber.
 
     ros2_rate.py --bin BUILD/bin [--distros jazzy,kilted] [--seconds 60] [--settle 3] --out DIR
+    ros2_rate.py --table DIR/ros2_rate.json      (prints the table of a saved run)
 
 Per distribution (make deps' ROS 2 environments, ros2/env.sh with RSG_ROS_DISTRO), on a DDS domain
 of its own, two runs one after the other:
@@ -102,23 +103,27 @@ def table(result):
     lines = [f"### rclpy subscriber at 1 kHz, {result['seconds']:.0f} s per run, on {result['cpu']} "
              f"({result['cores']} cores)", "",
              "| ROS 2 node (its Fast DDS) | source | received/s | received | lost | duplicates "
-             "| inter-arrival p50 / p99 / max ms | subscriber CPU % | source's rate |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+             "| inter-arrival p50 / p99 / max ms | subscriber CPU % | source's rate | load average before |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for run in result["runs"]:
         sub = run["subscriber"]
         node = f"{run['distro'].capitalize()} ({FASTDDS.get(run['distro'], '?')})"
         if "error" in sub:
-            lines.append(f"| {node} | {run['source']} | failed: {sub['error']} | | | | | | |")
+            lines.append(f"| {node} | {run['source']} | failed: {sub['error']} | | | | | | | |")
             continue
         gaps = sub["interarrival_ms"]
         source = "rsg_sim 1000 Hz" if run["source"] == "rsg_gateway" else f"{run['source_rate_hz']} Hz"
         lines.append(f"| {node} | {'`rsg_gateway --ros2` (Fast DDS 2.9.1)' if run['source'] == 'rsg_gateway' else 'rclpy publisher, same distribution'} "
                      f"| {sub['rate_hz']} | {sub['received']} | {sub['lost']} | {sub['duplicates']} "
-                     f"| {gaps['p50']} / {gaps['p99']} / {gaps['max']} | {sub['cpu_pct']} | {source} |")
+                     f"| {gaps['p50']} / {gaps['p99']} / {gaps['max']} | {sub['cpu_pct']} | {source} "
+                     f"| {run['load_average_before'][0]} |")
     return "\n".join(lines)
 
 
 def main():
+    if len(sys.argv) == 3 and sys.argv[1] == "--table":  # the table of a saved ros2_rate.json
+        print(table(json.loads(Path(sys.argv[2]).read_text())))
+        return
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--bin", required=True)
     parser.add_argument("--distros", default="jazzy,kilted")
