@@ -165,7 +165,10 @@ void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::
   const wire::FrameView& frame = decoded.frame();
 
   const std::optional<std::uint64_t> robot_time_ms = frame_time(frame, slot.sample());
+  const std::uint64_t restarts = sequence_.counts().restarts;
   sequence_.observe(frame.packet_number(), robot_time_ms);
+  if (sequence_.counts().restarts != restarts)  // the robot's clock began again: so do the ages
+    age_floor_ns_ = age_floor_last_ns_ = kNoFloor;
   link_came_up_ |= link_.on_frame(arrival);
   source_ = datagram.from;
   if (requester_ && requester_->due(frame.selection(), now))
@@ -185,9 +188,23 @@ void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::
     ++counters_.published;
   else
     ++counters_.publish_failed;
-  const auto delay = Clock::now() - arrival;
+  const auto published = Clock::now();
+  const auto delay = published - arrival;
   delay_period_max_ = std::max(delay_period_max_, delay);
   delay_max_ = std::max(delay_max_, delay);
+  delay_histogram_.record(delay);
+  if (robot_time_ms) record_age(*robot_time_ms, arrival, published);
+}
+
+void Ingress::record_age(std::uint64_t robot_time_ms, Clock::time_point arrival,
+                         Clock::time_point published) {
+  const auto ns = [](Clock::time_point t) {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count();
+  };
+  const std::int64_t robot_ns = static_cast<std::int64_t>(robot_time_ms) * 1'000'000;
+  age_floor_ns_ = std::min(age_floor_ns_, ns(arrival) - robot_ns);
+  const std::int64_t floor = std::min(age_floor_ns_, age_floor_last_ns_);
+  age_histogram_.record(std::chrono::nanoseconds(ns(published) - robot_ns - floor));
 }
 
 void Ingress::write_rate_topics(const RobotState& sample, std::chrono::nanoseconds t) {
@@ -230,7 +247,10 @@ bool Ingress::link_changed(Clock::time_point now) {
   return came_up || went_down;
 }
 
-void Ingress::end_status_period() { delay_period_max_ = {}; }
+void Ingress::end_status_period() {
+  delay_period_max_ = {};
+  age_floor_last_ns_ = std::exchange(age_floor_ns_, kNoFloor);
+}
 
 void Ingress::fill(GatewayStats& stats) const {
   stats.ingress = counters_;

@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "clock.hpp"
 #include "decimator.hpp"
 #include "flight_recorder.hpp"
+#include "latency_histogram.hpp"
 #include "link_monitor.hpp"
 #include "ros2_standard_topics.hpp"
 #include "rsg/dds/owned.hpp"
@@ -91,6 +93,13 @@ class Ingress {
   /// Starts a new status period for the per-period figures (ingress_delay_us).
   void end_status_period();
 
+  /// Every valid frame's arrival -> publication since start.
+  const LatencyHistogram& delay_histogram() const { return delay_histogram_; }
+  /// Every valid frame's age at publication, from the robot's `time` (frames that carry it), beyond
+  /// the quickest frame's of the current and the last status period: the robot's clock is not this
+  /// host's, so only what a frame took longer than the quickest one recently can be told.
+  const LatencyHistogram& age_histogram() const { return age_histogram_; }
+
   /// Logs one line when frames were rejected since the last call (the caller calls it once a second).
   void log_rejections();
 
@@ -112,6 +121,7 @@ class Ingress {
   void reject(const wire::FrameError& error, const transport::Endpoint& sender);
   void request_selection(const transport::Endpoint& robot, Clock::time_point now);
   void write_rate_topics(const RobotState& sample, std::chrono::nanoseconds t);
+  void record_age(std::uint64_t robot_time_ms, Clock::time_point arrival, Clock::time_point published);
 
   // A downsampled writer: writes the frames its decimator takes.
   struct RateWriter {
@@ -138,8 +148,16 @@ class Ingress {
   SequenceTracker sequence_;
   LinkMonitor link_;
   bool link_came_up_ = false;
-  Clock::duration delay_period_max_{};      // arrival -> publication, this status period
-  Clock::duration delay_max_{};             // and since start
+  Clock::duration delay_period_max_{};  // arrival -> publication, this status period
+  Clock::duration delay_max_{};         // and since start
+  LatencyHistogram delay_histogram_;
+  LatencyHistogram age_histogram_;
+  // The least (arrival - robot time) of this status period and of the last, in ns: the quickest
+  // frames' offset between the two clocks, which frame ages are measured from. Two periods, so
+  // that the floor follows a drift of the robot's clock and forgets a robot's restart.
+  static constexpr std::int64_t kNoFloor = std::numeric_limits<std::int64_t>::max();
+  std::int64_t age_floor_ns_ = kNoFloor;
+  std::int64_t age_floor_last_ns_ = kNoFloor;
   std::optional<FlightRecorder> recorder_;  // receives into its ring instead of batch_'s storage
   std::optional<SelectionRequester> requester_;
   std::uint8_t request_packet_number_ = 0;

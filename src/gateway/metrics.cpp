@@ -12,7 +12,7 @@
 namespace rsg::gateway {
 namespace {
 
-enum class Type { kCounter, kGauge };
+enum class Type { kCounter, kGauge, kHistogram };
 
 struct Family {
   std::string_view name;
@@ -71,8 +71,12 @@ constexpr Family kStateReaders{"rsg_state_readers", Type::kGauge, "Readers match
 constexpr Family kStandardReaders{"rsg_standard_topics_readers", Type::kGauge,
                                   "Readers matched by the ROS 2 standard topics' writers, summed"};
 constexpr Family kEgressWriters{"rsg_egress_writers", Type::kGauge, "Writers matched by the egress reader"};
-constexpr Family kDelay{"rsg_ingress_delay_seconds", Type::kGauge,
-                        "Longest time from a frame's arrival to its publication over the last status period"};
+constexpr Family kDelay{"rsg_ingress_delay_seconds", Type::kHistogram,
+                        "Time from a valid frame's arrival at the socket to its publication"};
+constexpr Family kAge{"rsg_frame_age_seconds", Type::kHistogram,
+                      "Time from the robot's time stamp of a frame to its publication, beyond the quickest "
+                      "frame's of the last 1-2 s (the robot's clock is not the host's): the robot's and the "
+                      "network's jitter and the gateway's delay"};
 constexpr Family kDelayMax{"rsg_ingress_delay_max_seconds", Type::kGauge,
                            "Longest time from a frame's arrival to its publication since start"};
 constexpr Family kCpu{"process_cpu_seconds_total", Type::kCounter, "User and system CPU time spent, seconds"};
@@ -104,6 +108,7 @@ constexpr std::array kFamilies = {&kBuildInfo,
                                   &kStandardReaders,
                                   &kEgressWriters,
                                   &kDelay,
+                                  &kAge,
                                   &kDelayMax,
                                   &kCpu,
                                   &kRss,
@@ -138,15 +143,18 @@ class Writer {
 
   void family(const Family& family) {
     out_ += fmt::format("# HELP {} {}\n# TYPE {} {}\n", family.name, escape(family.help, false), family.name,
-                        family.type == Type::kCounter ? "counter" : "gauge");
+                        family.type == Type::kCounter ? "counter"
+                        : family.type == Type::kGauge ? "gauge"
+                                                      : "histogram");
   }
 
   // One sample with the common labels plus `extra` ("name=\"value\"", already escaped).
   template <class Value>
-  void sample(const Family& family, Value value, std::string_view extra = {}) {
+  void sample(const Family& family, Value value, std::string_view extra = {}, std::string_view suffix = {}) {
     std::string labels = labels_;
     if (!extra.empty()) labels += std::string(labels.empty() ? "" : ",") + std::string(extra);
     out_ += family.name;
+    out_ += suffix;
     if (!labels.empty()) out_ += '{' + labels + '}';
     if constexpr (std::is_floating_point_v<Value>)
       out_ += fmt::format(" {}\n", value);
@@ -158,6 +166,20 @@ class Writer {
   void one(const Family& f, Value value) {
     family(f);
     sample(f, value);
+  }
+
+  // _bucket{le=...} cumulative up to +Inf, _sum, _count.
+  void histogram(const Family& f, const LatencyHistogram& histogram) {
+    family(f);
+    std::uint64_t cumulative = 0;
+    for (std::size_t i = 0; i < LatencyHistogram::kBoundsNs.size(); ++i) {
+      cumulative += histogram.bucket_count(i);
+      sample(f, cumulative,
+             fmt::format("le=\"{}\"", static_cast<double>(LatencyHistogram::kBoundsNs[i]) / 1e9), "_bucket");
+    }
+    sample(f, histogram.count(), "le=\"+Inf\"", "_bucket");
+    sample(f, histogram.sum_seconds(), {}, "_sum");
+    sample(f, histogram.count(), {}, "_count");
   }
 
   std::string take() { return std::move(out_); }
@@ -269,7 +291,10 @@ std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<
   out.one(kStateReaders, stats.state_readers);
   out.one(kStandardReaders, stats.standard_readers);
   out.one(kEgressWriters, stats.egress_writers);
-  out.one(kDelay, seconds_of_us(stats.ingress_delay_us));
+  if (snapshot.has_ingress) {
+    out.histogram(kDelay, snapshot.ingress_delay);
+    out.histogram(kAge, snapshot.frame_age);
+  }
   out.one(kDelayMax, seconds_of_us(stats.ingress_delay_max_us));
 
   if (process) {
@@ -287,9 +312,12 @@ std::vector<std::string> metric_family_names() {
   return names;
 }
 
-bool is_healthy(const MetricsSnapshot& snapshot, Clock::time_point now, Clock::duration max_age) {
-  if (now - snapshot.taken > max_age) return false;
-  return !snapshot.has_ingress || snapshot.stats.link_up;
+bool is_live(const MetricsSnapshot& snapshot, Clock::time_point now, Clock::duration max_age) {
+  return now - snapshot.taken <= max_age;
+}
+
+bool is_ready(const MetricsSnapshot& snapshot, Clock::time_point now, Clock::duration max_age) {
+  return is_live(snapshot, now, max_age) && (!snapshot.has_ingress || snapshot.stats.link_up);
 }
 
 }  // namespace rsg::gateway

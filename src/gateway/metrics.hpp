@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "clock.hpp"
+#include "latency_histogram.hpp"
 #include "stats.hpp"
 
 namespace rsg::gateway {
@@ -37,9 +38,12 @@ struct MetricsSnapshot {
   bool has_ingress = false;
   std::optional<DumpCounts> dumps;  ///< with a flight recorder (--pcap-ring)
   DdsGuardCounts dds_guard;
+  LatencyHistogram ingress_delay;   ///< with ingress: arrival -> publication, every valid frame
+  LatencyHistogram frame_age;       ///< with ingress: the robot's time stamp -> publication (Ingress)
   /// Unix time (s) of the last link change; the gateway's start before the first.
   double link_last_change_s = 0;
-  /// The labels every series carries; an empty value leaves its label out.
+  /// The labels every series carries: `gateway` always (the gateway sets it to --name, the
+  /// partition or the host's name), `partition` unless empty.
   std::string gateway;
   std::string partition;
   std::string version;          ///< rsg's (the CMake project version)
@@ -65,10 +69,15 @@ std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<
 /// The names of every metric family `format_metrics` writes (for the dashboard check).
 std::vector<std::string> metric_family_names();
 
-/// True while the snapshot says valid frames arrive within the link deadline and it is no older
-/// than `max_age` (a snapshot that stops coming means the loop that takes it is stuck). A gateway
-/// without ingress is healthy while its snapshots come.
-bool is_healthy(const MetricsSnapshot& snapshot, Clock::time_point now, Clock::duration max_age);
+/// /livez: the process is alive, i.e. its loop still hands over snapshots: the snapshot is no older
+/// than `max_age` (one that stops coming means the loop that takes it is stuck). Says nothing of the
+/// robot: a gateway waiting for its robot is alive.
+bool is_live(const MetricsSnapshot& snapshot, Clock::time_point now, Clock::duration max_age);
+
+/// /readyz (and /healthz, its older name): alive, and valid frames arrive within the link deadline,
+/// i.e. the robot streams into DDS (the participant and writers exist from the start). A gateway
+/// without ingress is ready while it is alive.
+bool is_ready(const MetricsSnapshot& snapshot, Clock::time_point now, Clock::duration max_age);
 
 /// A label value escaped for the exposition format (backslash, double quote, line feed).
 std::string escape_label_value(std::string_view value);

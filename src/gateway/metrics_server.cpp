@@ -82,16 +82,18 @@ class Session : public std::enable_shared_from_this<Session> {
       return respond(version, keep_alive, http::status::ok,
                      head ? std::string() : format_metrics(*snapshot, read_process_figures()),
                      kExpositionType);
-    if (target == "/healthz") {
+    if (target == "/livez" || target == "/readyz" || target == "/healthz") {
+      // /healthz: /readyz's older name, kept for the health checks that use it.
       const auto now = Clock::now();
-      const bool healthy = is_healthy(*snapshot, now, shared_.options.max_snapshot_age);
-      const bool stale = now - snapshot->taken > shared_.options.max_snapshot_age;
-      return respond(version, keep_alive, healthy ? http::status::ok : http::status::service_unavailable,
-                     healthy ? "ok\n"
-                     : stale ? "stale: the gateway's loop has not reported for too long\n"
-                             : "link down\n");
+      const bool live = is_live(*snapshot, now, shared_.options.max_snapshot_age);
+      const bool ok = target == "/livez" ? live : is_ready(*snapshot, now, shared_.options.max_snapshot_age);
+      return respond(version, keep_alive, ok ? http::status::ok : http::status::service_unavailable,
+                     ok     ? "ok\n"
+                     : live ? "link down\n"
+                            : "stale: the gateway's loop has not reported for too long\n");
     }
-    respond(version, keep_alive, http::status::not_found, "not found: /metrics and /healthz only\n");
+    respond(version, keep_alive, http::status::not_found,
+            "not found: /metrics, /livez, /readyz and /healthz only\n");
   }
 
   void respond(unsigned version, bool keep_alive, http::status status, std::string body,

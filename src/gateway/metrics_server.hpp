@@ -1,6 +1,8 @@
 // `--metrics HOST:PORT`: an HTTP endpoint (Boost.Beast, one I/O thread of its own) that answers
 //   GET /metrics  the last MetricsSnapshot in Prometheus' text format (metrics.hpp)
-//   GET /healthz  200 while valid frames arrive within the link deadline, else 503
+//   GET /livez    200 while the gateway's loop hands over snapshots (the process works), else 503
+//   GET /readyz   200 while also valid frames arrive within the link deadline, else 503
+//   GET /healthz  /readyz, by its older name
 // and 404 to any other path, 405 to any other method.
 //
 // The ingress thread never waits for the HTTP side: `publish` swaps in a new snapshot (an atomic
@@ -24,7 +26,7 @@ class MetricsServer {
   struct Options {
     transport::Endpoint listen;  ///< port 0: any free port (see port())
     std::size_t max_connections = 32;
-    /// A snapshot older than this makes /healthz answer 503: the loop that takes them is stuck.
+    /// A snapshot older than this makes /livez and /readyz answer 503: the loop that takes them is stuck.
     Clock::duration max_snapshot_age = std::chrono::seconds(3);
   };
 

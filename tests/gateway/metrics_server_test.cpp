@@ -99,13 +99,30 @@ TEST(MetricsServer, MetricsAnswersTheLastPublishedSnapshotInTheExpositionFormat)
   EXPECT_NE(response.find("\nrsg_frames_published_total{gateway=\"robot1\"} 6\n"), std::string::npos);
 }
 
-TEST(MetricsServer, HealthzFollowsTheLink) {
+// /readyz (and /healthz, its older name) follow the link; /livez only the loop's snapshots.
+TEST(MetricsServer, ReadyzAndHealthzFollowTheLinkLivezDoesNot) {
   MetricsServer server(loopback(), snapshot(true));
-  EXPECT_TRUE(get(server.port(), "/healthz").starts_with("HTTP/1.1 200 OK\r\n"));
+  for (const char* path : {"/livez", "/readyz", "/healthz"})
+    EXPECT_TRUE(get(server.port(), path).starts_with("HTTP/1.1 200 OK\r\n")) << path;
   server.publish(snapshot(false));
-  const auto response = get(server.port(), "/healthz");
-  EXPECT_TRUE(response.starts_with("HTTP/1.1 503 Service Unavailable\r\n")) << response;
-  EXPECT_TRUE(response.ends_with("link down\n")) << response;
+  for (const char* path : {"/readyz", "/healthz"}) {
+    const auto response = get(server.port(), path);
+    EXPECT_TRUE(response.starts_with("HTTP/1.1 503 Service Unavailable\r\n")) << path << response;
+    EXPECT_TRUE(response.ends_with("link down\n")) << path << response;
+  }
+  EXPECT_TRUE(get(server.port(), "/livez").starts_with("HTTP/1.1 200 OK\r\n"));
+}
+
+// A loop that stopped handing over snapshots: not alive, so not ready either.
+TEST(MetricsServer, AStaleSnapshotFailsLivezAndReadyz) {
+  MetricsSnapshot old = snapshot(true);
+  old.taken = Clock::now() - std::chrono::seconds(10);
+  MetricsServer server(loopback(), old);
+  for (const char* path : {"/livez", "/readyz"}) {
+    const auto response = get(server.port(), path);
+    EXPECT_TRUE(response.starts_with("HTTP/1.1 503 Service Unavailable\r\n")) << path << response;
+    EXPECT_TRUE(response.ends_with("the gateway's loop has not reported for too long\n")) << path << response;
+  }
 }
 
 TEST(MetricsServer, OtherPathsAre404AndOtherMethods405) {

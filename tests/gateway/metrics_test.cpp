@@ -34,6 +34,8 @@ MetricsSnapshot example() {
   stats.ingress_delay_us = 250;
   stats.ingress_delay_max_us = 1500;
   snapshot.dumps = DumpCounts{4, 1, 2};
+  for (const auto us : {30, 250, 250, 4000}) snapshot.ingress_delay.record(std::chrono::microseconds(us));
+  snapshot.frame_age.record(std::chrono::seconds(2));  // above every bound: +Inf only
   return snapshot;
 }
 
@@ -68,7 +70,6 @@ TEST(Metrics, EachCounterOfTheSnapshotIsOneSampleWithTheGatewaysLabels) {
   EXPECT_EQ(values.at(series("rsg_link_up")), "1");
   EXPECT_EQ(values.at(series("rsg_frame_rate_hertz")), "999.5");
   EXPECT_EQ(values.at(series("rsg_link_last_change_timestamp_seconds")), "1764165600.5");
-  EXPECT_EQ(values.at(series("rsg_ingress_delay_seconds")), "0.00025");
   EXPECT_EQ(values.at(series("rsg_ingress_delay_max_seconds")), "0.0015");
   EXPECT_EQ(values.at(series("rsg_build_info", R"(version="0.1.0",fastdds_version="2.9.1")")), "1");
 }
@@ -121,6 +122,10 @@ TEST(Metrics, EveryFamilyHasHelpAndTypeBeforeItsSamplesAndCountersEndInTotal) {
       continue;
     }
     name = first.substr(0, first.find('{'));
+    for (const std::string_view suffix : {"_bucket", "_sum", "_count"})
+      if (name.ends_with(suffix) && types[name.substr(0, name.size() - suffix.size())] == "histogram")
+        name.resize(name.size() - suffix.size());
+    std::erase_if(types, [](const auto& entry) { return entry.second.empty(); });
     ASSERT_TRUE(types.contains(name)) << name << ": a sample before its TYPE";
     sampled.insert(name);
   }
@@ -129,20 +134,46 @@ TEST(Metrics, EveryFamilyHasHelpAndTypeBeforeItsSamplesAndCountersEndInTotal) {
   for (const auto& [name, type] : types) {
     EXPECT_TRUE(helped.contains(name)) << name;
     EXPECT_EQ(type == "counter", name.ends_with("_total")) << name << " is a " << type;
-    EXPECT_TRUE(type == "counter" || type == "gauge") << name;
+    EXPECT_TRUE(type == "counter" || type == "gauge" || type == "histogram") << name;
   }
   const auto values = samples(text);
   EXPECT_EQ(values.at(series("process_cpu_seconds_total")), "12.5");
   EXPECT_EQ(values.at(series("process_resident_memory_bytes")), "4096000");
 }
 
-TEST(Metrics, WithoutANameOrPartitionTheSeriesCarryNoGatewayLabels) {
+TEST(Metrics, WithoutAPartitionTheSeriesCarryTheGatewayLabelOnly) {
   MetricsSnapshot snapshot = example();
-  snapshot.gateway.clear();
   snapshot.partition.clear();
   const auto values = samples(format_metrics(snapshot, std::nullopt));
-  EXPECT_EQ(values.at("rsg_frames_published_total"), "1000");
-  EXPECT_EQ(values.at("rsg_frames_invalid_total{category=\"bad_crc\"}"), "150");
+  EXPECT_EQ(values.at("rsg_frames_published_total{gateway=\"robot1\"}"), "1000");
+  EXPECT_EQ(values.at("rsg_frames_invalid_total{gateway=\"robot1\",category=\"bad_crc\"}"), "150");
+}
+
+// Prometheus' histogram: cumulative _bucket series by `le` up to +Inf, then _sum and _count.
+TEST(Metrics, IngressDelayAndFrameAgeAreHistogramsWithCumulativeBuckets) {
+  const auto text = format_metrics(example(), std::nullopt);
+  EXPECT_NE(text.find("# TYPE rsg_ingress_delay_seconds histogram\n"), std::string::npos);
+  EXPECT_NE(text.find("# TYPE rsg_frame_age_seconds histogram\n"), std::string::npos);
+  const auto values = samples(text);
+  const auto bucket = [&](std::string_view name, std::string_view le) {
+    return values.at(series(name, "le=\"" + std::string(le) + "\""));
+  };
+  EXPECT_EQ(bucket("rsg_ingress_delay_seconds_bucket", "5e-05"), "1");
+  EXPECT_EQ(bucket("rsg_ingress_delay_seconds_bucket", "0.0001"), "1");
+  EXPECT_EQ(bucket("rsg_ingress_delay_seconds_bucket", "0.00025"), "3");  // le: 250 us counts in 0.00025
+  EXPECT_EQ(bucket("rsg_ingress_delay_seconds_bucket", "0.0025"), "3");
+  EXPECT_EQ(bucket("rsg_ingress_delay_seconds_bucket", "0.005"), "4");
+  EXPECT_EQ(bucket("rsg_ingress_delay_seconds_bucket", "1"), "4");
+  EXPECT_EQ(bucket("rsg_ingress_delay_seconds_bucket", "+Inf"), "4");
+  EXPECT_EQ(values.at(series("rsg_ingress_delay_seconds_count")), "4");
+  EXPECT_EQ(values.at(series("rsg_ingress_delay_seconds_sum")), "0.00453");
+  EXPECT_EQ(bucket("rsg_frame_age_seconds_bucket", "1"), "0");
+  EXPECT_EQ(bucket("rsg_frame_age_seconds_bucket", "+Inf"), "1");
+  EXPECT_EQ(values.at(series("rsg_frame_age_seconds_sum")), "2");
+  MetricsSnapshot egress_only = example();
+  egress_only.has_ingress = false;
+  EXPECT_EQ(format_metrics(egress_only, std::nullopt).find("rsg_ingress_delay_seconds_bucket"),
+            std::string::npos);
 }
 
 TEST(Metrics, LabelValuesEscapeBackslashQuoteAndLineFeed) {
@@ -157,17 +188,20 @@ TEST(Metrics, TheProcessFiguresOfThisProcessAreRead) {
   EXPECT_GE(process->open_fds, 3);          // stdin, stdout, stderr
 }
 
-TEST(Metrics, HealthyWhileTheLinkIsUpAndTheSnapshotIsFresh) {
+TEST(Metrics, LiveWhileTheSnapshotIsFreshReadyWhileTheLinkIsUpToo) {
   MetricsSnapshot snapshot = example();
   const auto now = Clock::now();
   snapshot.taken = now;
   const auto max_age = std::chrono::seconds(3);
-  EXPECT_TRUE(is_healthy(snapshot, now + std::chrono::seconds(1), max_age));
-  EXPECT_FALSE(is_healthy(snapshot, now + std::chrono::seconds(4), max_age)) << "a stale snapshot";
+  EXPECT_TRUE(is_ready(snapshot, now + std::chrono::seconds(1), max_age));
+  EXPECT_TRUE(is_live(snapshot, now + std::chrono::seconds(1), max_age));
+  EXPECT_FALSE(is_ready(snapshot, now + std::chrono::seconds(4), max_age)) << "a stale snapshot";
+  EXPECT_FALSE(is_live(snapshot, now + std::chrono::seconds(4), max_age)) << "a stale snapshot";
   snapshot.stats.link_up = false;
-  EXPECT_FALSE(is_healthy(snapshot, now, max_age)) << "link down";
+  EXPECT_FALSE(is_ready(snapshot, now, max_age)) << "link down";
+  EXPECT_TRUE(is_live(snapshot, now, max_age)) << "link down: waiting for the robot is alive";
   snapshot.has_ingress = false;
-  EXPECT_TRUE(is_healthy(snapshot, now, max_age)) << "egress only: no link to watch";
+  EXPECT_TRUE(is_ready(snapshot, now, max_age)) << "egress only: no link to watch";
 }
 
 }  // namespace
