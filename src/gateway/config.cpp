@@ -129,15 +129,18 @@ const std::array kKeys = {
     ConfigKey{"stats-file", "Keep the counters as JSON in this file (rewritten every second and at exit)",
               &GatewayConfig::stats_file, [](const GatewayConfig&) { return std::string(); }},
     ConfigKey{"metrics",
-              "Serve Prometheus metrics on http://HOST:PORT/metrics and a health check on /healthz "
-              "(200 while valid frames arrive in time, else 503)",
+              "Serve Prometheus metrics on http://HOST:PORT/metrics, liveness on /livez (200 while the "
+              "gateway runs) and readiness on /readyz (200 while valid frames arrive in time, else 503; "
+              "also /healthz)",
               &GatewayConfig::metrics,
               [](const GatewayConfig& c) {
                 return c.metrics.empty()
                            ? ""
                            : check_host_port(c.metrics, transport::HostPortRule::kPortMayBeZero);
               }},
-    ConfigKey{"name", "This gateway's name: the `gateway` label of its metrics (default: the partition)",
+    ConfigKey{"name",
+              "This gateway's name: the `gateway` label of its metrics (default: the partition, else the "
+              "host's name)",
               &GatewayConfig::name, [](const GatewayConfig&) { return std::string(); }},
     ConfigKey{"pcap-ring",
               "Flight recorder: keep the last SECONDS of raw datagrams in memory and write them as a pcap "
@@ -154,6 +157,15 @@ const std::array kKeys = {
                 for (const char* level : kLevels)
                   if (c.log_level == level) return std::string();
                 return "'" + c.log_level + "' is not one of trace, debug, info, warn, error, off";
+              }},
+    ConfigKey{"log-format",
+              "text (one line per event, timestamped unless the journal is stderr) or json (one JSON object "
+              "per line: time, level, logger, message)",
+              &GatewayConfig::log_format,
+              [](const GatewayConfig& c) {
+                return c.log_format == "text" || c.log_format == "json"
+                           ? std::string()
+                           : "'" + c.log_format + "' is not one of text, json";
               }},
     ConfigKey{"rt-priority",
               "Run the ingress thread SCHED_FIFO at this priority (1..99) and lock the process's memory "

@@ -48,10 +48,11 @@ struct GatewayConfig {
   int restart_threshold_ms = 100;
   std::string stats_file;
   std::string log_level = "info";
+  std::string log_format = "text";  ///< once started: "text" or "json" (journal_log.hpp)
 
   // Monitoring: Prometheus metrics and /healthz on HOST:PORT (metrics_server.hpp); "" : off
   std::string metrics;
-  std::string name;  ///< the `gateway` label of the metrics; "" : the partition
+  std::string name;  ///< the `gateway` label of the metrics; "" : the partition, else the host's name
 
   // Flight recorder: the last pcap_ring seconds of raw datagrams, dumped into pcap_dir as pcap
   double pcap_ring = 0;  ///< seconds; 0: off

@@ -6,12 +6,14 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <filesystem>
 #include <stdexcept>
 #include <thread>
 
+#include "credentials.hpp"
 #include "errno_text.hpp"
 #include "realtime.hpp"
 #include "rsg/dds/discovery.hpp"
@@ -29,7 +31,6 @@ namespace {
 using std::chrono::milliseconds;
 
 constexpr auto kStatusPeriod = std::chrono::seconds(1);
-constexpr auto kSummaryPeriod = std::chrono::seconds(10);
 // The longest the loop sleeps: bounds how late it notices a stop request or a due status.
 constexpr milliseconds kLongestWait{100};
 
@@ -39,6 +40,16 @@ transport::Endpoint resolve(const std::string& flag, const std::string& host_por
   } catch (const InputError& error) {
     throw InputError("--" + flag + ": " + error.what());
   }
+}
+
+// The `gateway` label: --name, else the partition, else the host's name, so that every gateway has
+// one (a dashboard finds the gateways by it) and two hosts' unnamed gateways differ.
+std::string gateway_label(const GatewayConfig& config) {
+  if (!config.name.empty()) return config.name;
+  if (!config.partition.empty()) return config.partition;
+  std::array<char, 256> host{};
+  if (::gethostname(host.data(), host.size() - 1) == 0 && host[0] != '\0') return host.data();
+  return "rsg_gateway";
 }
 
 double unix_now_s() {
@@ -80,12 +91,17 @@ InputError no_profile(const GatewayConfig& config, const std::string& kind, cons
   return InputError(profiles_of(config).string() + ": no " + kind + " profile named '" + name + "'");
 }
 
-// The participant profile's QoS; looked up before anything exists, and again to create the participant.
+// The participant profile's QoS, with systemd's credentials directory in its properties
+// (credentials.hpp); looked up before anything exists, and again to create the participant.
 fdds::DomainParticipantQos profile_participant_qos(const GatewayConfig& config) {
   fdds::DomainParticipantQos qos;
   if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
           config.participant_profile, qos) != dds::kOk)
     throw no_profile(config, "participant", config.participant_profile);
+  for (auto& property : qos.properties().properties())
+    property.value() = expand_credentials_directory(
+        property.value(), std::getenv("CREDENTIALS_DIRECTORY"),
+        "participant profile '" + config.participant_profile + "', property " + property.name());
   return qos;
 }
 
@@ -249,9 +265,11 @@ Gateway::Gateway(const GatewaySetup& setup)
     spdlog::info("egress: topic '{}' -> UDP {}", setup.egress->topic, fmt::join(config_.send_to, ", "));
   }
   link_last_change_s_ = unix_now_s();
+  gateway_label_ = gateway_label(config_);
   if (setup.metrics) {
     metrics_.emplace(MetricsServer::Options{*setup.metrics}, metrics_snapshot(snapshot(), Clock::now()));
-    spdlog::info("metrics: /metrics and /healthz on {} (TCP port {})", config_.metrics, metrics_->port());
+    spdlog::info("metrics: /metrics, /livez and /readyz on {} (TCP port {})", config_.metrics,
+                 metrics_->port());
   }
 }
 
@@ -268,7 +286,7 @@ void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump, LoopOb
   if (metrics_) metrics_->publish(metrics_snapshot(first, start));
   if (observer != nullptr) observer->started(first, ingress_.has_value());
   auto next_status = start + kStatusPeriod;
-  next_summary_ = start + kSummaryPeriod;
+  summary_.emplace(start);
 
   while (!stop.load(std::memory_order_relaxed)) {
     // Wake for the next frame, the next status, or the moment silence means the link is down.
@@ -330,10 +348,8 @@ GatewayStats Gateway::on_status_period(Clock::time_point now) {
   if (metrics_) metrics_->publish(metrics_snapshot(stats, now));
   if (no_link_)
     if (const auto warning = no_link_->due(stats, now)) spdlog::warn("{}", *warning);
-  if (now >= next_summary_) {
-    next_summary_ = now + kSummaryPeriod;
-    spdlog::info("{}", summary_line(stats));
-  }
+  if (summary_->may_log(now))
+    if (std::string line = summary_line(stats); summary_->due(line, now)) spdlog::info("{}", line);
   return stats;
 }
 
@@ -360,7 +376,11 @@ MetricsSnapshot Gateway::metrics_snapshot(const GatewayStats& stats, Clock::time
                                      guard.send_channels_opened.load(std::memory_order_relaxed),
                                      guard.destinations_skipped.load(std::memory_order_relaxed)};
   metrics.link_last_change_s = link_last_change_s_;
-  metrics.gateway = config_.name.empty() ? config_.partition : config_.name;
+  if (ingress_) {
+    metrics.ingress_delay = ingress_->delay_histogram();
+    metrics.frame_age = ingress_->age_histogram();
+  }
+  metrics.gateway = gateway_label_;
   metrics.partition = config_.partition;
   metrics.version = rsg_version();
   metrics.fastdds_version = fastdds_version();

@@ -13,6 +13,7 @@
 #include "egress.hpp"
 #include "ingress.hpp"
 #include "link_monitor.hpp"
+#include "log_throttle.hpp"
 #include "loop_observer.hpp"
 #include "metrics_server.hpp"
 #include "no_link_warning.hpp"
@@ -66,11 +67,12 @@ class Gateway {
   std::optional<Egress> egress_;
   RateMeter rate_;
   double rate_hz_ = 0;
-  Clock::time_point next_summary_{};
+  std::optional<SummaryPacer> summary_;    // from run()
   std::optional<NoLinkWarning> no_link_;   // with ingress
   StatsFile stats_file_;                   // --stats-file, written by a thread of its own
   std::optional<DumpWriter> dump_writer_;  // with a flight recorder: writes its dumps
   double link_last_change_s_ = 0;          // Unix time, for the metrics
+  std::string gateway_label_;              // the metrics' `gateway` label
   std::optional<MetricsServer> metrics_;   // last: serves snapshots of everything above
 };
 

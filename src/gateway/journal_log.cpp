@@ -1,5 +1,7 @@
 #include "journal_log.hpp"
 
+#include <fmt/format.h>
+#include <spdlog/details/log_msg.h>
 #include <spdlog/pattern_formatter.h>
 #include <spdlog/sinks/base_sink.h>
 #include <spdlog/spdlog.h>
@@ -8,8 +10,10 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "rsg/wire/number.hpp"
@@ -17,19 +21,53 @@
 namespace rsg::gateway {
 namespace {
 
-// stderr, each line behind "<N>". Formats with whatever pattern the logger gives its sinks.
+// A log line as one JSON object (json_log_line).
+class JsonFormatter : public spdlog::formatter {
+ public:
+  explicit JsonFormatter(bool with_time) : with_time_(with_time) {}
+  void format(const spdlog::details::log_msg& message, spdlog::memory_buf_t& dest) override {
+    const std::string line = json_log_line(message, with_time_);
+    dest.append(line.data(), line.data() + line.size());
+    dest.push_back('\n');
+  }
+  std::unique_ptr<spdlog::formatter> clone() const override {
+    return std::make_unique<JsonFormatter>(with_time_);
+  }
+
+ private:
+  bool with_time_;
+};
+
+// stderr, each line behind "<N>", formatted without a time of its own: the journal has it. A
+// pattern set on the logger later (rsg::app::log_with_timestamps) does not reach this sink.
 class JournalSink : public spdlog::sinks::base_sink<std::mutex> {
+ public:
+  JournalSink() { use_text(); }
+  void use_text() { own_formatter_ = std::make_unique<spdlog::pattern_formatter>("%n: %v"); }
+  void use_json() { own_formatter_ = std::make_unique<JsonFormatter>(false); }
+
  protected:
   void sink_it_(const spdlog::details::log_msg& message) override {
     spdlog::memory_buf_t line;
-    formatter_->format(message, line);
+    own_formatter_->format(message, line);
     const std::string prefix = "<" + std::to_string(journal_priority(message.level)) + ">";
     std::fwrite(prefix.data(), 1, prefix.size(), stderr);
     std::fwrite(line.data(), 1, line.size(), stderr);
     std::fflush(stderr);
   }
   void flush_() override { std::fflush(stderr); }
+  void set_pattern_(const std::string&) override {}
+  void set_formatter_(std::unique_ptr<spdlog::formatter>) override {}
+
+ private:
+  std::unique_ptr<spdlog::formatter> own_formatter_;  // guarded by the sink's mutex once logging
 };
+
+JournalSink* journal_sink() {
+  for (const auto& sink : spdlog::default_logger()->sinks())
+    if (auto* journal = dynamic_cast<JournalSink*>(sink.get())) return journal;
+  return nullptr;
+}
 
 }  // namespace
 
@@ -64,11 +102,34 @@ bool stderr_is_journal() {
 void use_journal_priorities() {
   if (!stderr_is_journal()) return;
   const auto logger = spdlog::default_logger();
-  auto sink = std::make_shared<JournalSink>();
-  // The journal has the time, and the priority says what "warning:" said.
-  sink->set_formatter(std::make_unique<spdlog::pattern_formatter>("%n: %v"));
   logger->sinks().clear();
-  logger->sinks().push_back(std::move(sink));
+  logger->sinks().push_back(std::make_shared<JournalSink>());
+}
+
+void use_json_log_lines() {
+  if (JournalSink* journal = journal_sink())
+    journal->use_json();
+  else
+    spdlog::default_logger()->set_formatter(std::make_unique<JsonFormatter>(true));
+}
+
+std::string json_log_line(const spdlog::details::log_msg& message, bool with_time) {
+  nlohmann::ordered_json line;
+  if (with_time) {
+    const auto since_epoch = message.time.time_since_epoch();
+    const std::time_t seconds = std::chrono::duration_cast<std::chrono::seconds>(since_epoch).count();
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(since_epoch).count() % 1000;
+    std::tm utc{};
+    ::gmtime_r(&seconds, &utc);
+    line["time"] = fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}.{:03}Z", utc.tm_year + 1900,
+                               utc.tm_mon + 1, utc.tm_mday, utc.tm_hour, utc.tm_min, utc.tm_sec, ms);
+  }
+  const auto level = spdlog::level::to_string_view(message.level);
+  line["level"] = std::string(level.data(), level.size());
+  line["logger"] = std::string(message.logger_name.data(), message.logger_name.size());
+  line["message"] = std::string(message.payload.data(), message.payload.size());
+  // Replacing what is not UTF-8 (a peer's bytes in a message) rather than throwing.
+  return line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace rsg::gateway

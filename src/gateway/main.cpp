@@ -105,13 +105,15 @@ int main(int argc, char** argv) {
   return rsg::app::run_main(app, argc, argv, [&] {
     const GatewayConfig config = read_config(config_file, flags_only, argc, argv);
     spdlog::set_level(spdlog::level::from_str(config.log_level));
+    if (config.log_format == "json") rsg::gateway::use_json_log_lines();  // every line from here on
     const rsg::gateway::GatewaySetup setup = rsg::gateway::prepare(config);
     // SIGUSR1 asks for a flight-recorder dump: the loop takes it when it sees `dump`.
     std::atomic<bool> stop{false};
     std::atomic<bool> dump{false};
     const StopOnSignal signals([&stop] { stop = true; }, [&dump] { dump = true; });
     rsg::gateway::Gateway gateway(setup);
-    rsg::app::log_with_timestamps();  // started: from here on a log of a running service
+    // Started: from here on a log of a running service, with times (but for the journal's own).
+    if (config.log_format != "json") rsg::app::log_with_timestamps();
     rsg::gateway::enter_realtime_mode(config);
     rsg::gateway::ServiceNotifier systemd;  // READY, STATUS and the watchdog under a Type=notify unit
     gateway.run(stop, &dump, &systemd);

@@ -37,16 +37,34 @@ void ServiceNotifier::watchdog(Clock::time_point now) {
   notify("WATCHDOG=1");
 }
 
+void ServiceNotifier::status(const GatewayStats& stats, bool has_ingress) {
+  IngressCounters period;
+  period.rejected_source = stats.ingress.rejected_source - last_.rejected_source;
+  for (std::size_t i = 0; i < period.invalid.size(); ++i)
+    period.invalid[i] = stats.ingress.invalid[i] - last_.invalid[i];
+  last_ = stats.ingress;
+  set_status(service_status_line(stats, has_ingress, period));
+}
+
 void ServiceNotifier::stopping() { notify("STOPPING=1"); }
 
-std::string service_status_line(const GatewayStats& stats, bool has_ingress) {
+std::string service_status_line(const GatewayStats& stats, bool has_ingress, const IngressCounters& period) {
   const std::uint32_t readers = stats.state_readers + stats.standard_readers;
   std::string line;
-  if (has_ingress)
+  if (has_ingress) {
     line = stats.link_up ? fmt::format("link up from {} at {:.1f} Hz", stats.source, stats.rate_hz)
                          : std::string("link down");
-  else
+    // What the log says once a second, in the line `systemctl status` shows: why the link is down.
+    std::string causes;
+    if (period.rejected_source > 0)
+      causes = fmt::format("ignoring {} datagrams/s from outside --allow-from", period.rejected_source);
+    if (const std::uint64_t invalid = period.invalid_total(); invalid > 0)
+      causes += fmt::format("{}rejecting {} invalid frames/s ({})", causes.empty() ? "" : ", ", invalid,
+                            format_invalid(period.invalid));
+    if (!causes.empty()) line += (stats.link_up ? ", " : ": ") + causes;
+  } else {
     line = fmt::format("egress only, {} sent", stats.egress.frames_sent);
+  }
   line += fmt::format(", {} reader{}", readers, readers == 1 ? "" : "s");
   if (stats.egress_writers > 0)
     line += fmt::format(", {} egress writer{}", stats.egress_writers, stats.egress_writers == 1 ? "" : "s");

@@ -19,8 +19,12 @@
 
 namespace rsg::gateway {
 
-/// The STATUS= line: "link up from HOST:PORT at 1000.0 Hz, 2 readers" (no line feed).
-std::string service_status_line(const GatewayStats& stats, bool has_ingress);
+/// The STATUS= line: "link up from HOST:PORT at 1000.0 Hz, 2 readers" (no line feed). With
+/// `period`, the ingress counters' increase over the last status period (1 s), it names what keeps
+/// a link down or what goes on beside it: "link down: ignoring 1000 datagrams/s from outside
+/// --allow-from, 0 readers", "link down: rejecting 1000 invalid frames/s (bad_crc=1000), 0 readers".
+std::string service_status_line(const GatewayStats& stats, bool has_ingress,
+                                const IngressCounters& period = {});
 
 class ServiceNotifier : public LoopObserver {
  public:
@@ -30,12 +34,11 @@ class ServiceNotifier : public LoopObserver {
   // The gateway loop's events: READY=1 with the first STATUS=, STATUS= each period, WATCHDOG=1
   // from each turn (at most every half interval), STOPPING=1.
   void started(const GatewayStats& stats, bool has_ingress) override {
+    last_ = stats.ingress;
     ready(service_status_line(stats, has_ingress));
   }
   void turned(Clock::time_point now) override { watchdog(now); }
-  void status(const GatewayStats& stats, bool has_ingress) override {
-    set_status(service_status_line(stats, has_ingress));
-  }
+  void status(const GatewayStats& stats, bool has_ingress) override;
   void stopping() override;
 
   /// True when a service manager listens (NOTIFY_SOCKET is set).
@@ -56,7 +59,8 @@ class ServiceNotifier : public LoopObserver {
   bool active_ = false;
   std::optional<Clock::duration> watchdog_;
   std::optional<Clock::time_point> last_ping_;
-  bool failed_ = false;  // a notification failed: said once, not every time
+  bool failed_ = false;   // a notification failed: said once, not every time
+  IngressCounters last_;  // as of the last status line: the next one tells what changed since
 };
 
 }  // namespace rsg::gateway

@@ -90,6 +90,32 @@ TEST(ServiceNotifier, StartedSendsReadyWithAStatusLine) {
   EXPECT_EQ(socket.next(), "STOPPING=1");
 }
 
+TEST(ServiceNotifier, TheStatusLineNamesWhatKeepsTheLinkDown) {
+  NotifySocket socket;
+  ServiceNotifier notifier;
+  GatewayStats stats;
+  stats.ingress.rejected_source = 5;  // before the start: not this period's
+  notifier.started(stats, true);
+  EXPECT_EQ(socket.next(), "READY=1\nSTATUS=link down, 0 readers");
+  stats.ingress.rejected_source += 1000;
+  notifier.status(stats, true);
+  EXPECT_EQ(socket.next(),
+            "STATUS=link down: ignoring 1000 datagrams/s from outside --allow-from, 0 readers");
+  stats.ingress.invalid[invalid_index(wire::ErrorCategory::kBadCrc)] += 20;
+  notifier.status(stats, true);
+  EXPECT_EQ(socket.next(), "STATUS=link down: rejecting 20 invalid frames/s (bad_crc=20), 0 readers");
+  notifier.status(stats, true);  // nothing new: nothing to name
+  EXPECT_EQ(socket.next(), "STATUS=link down, 0 readers");
+  GatewayStats up = streaming();
+  up.ingress = stats.ingress;
+  up.ingress.rejected_source += 3;
+  notifier.status(up, true);
+  EXPECT_EQ(
+      socket.next(),
+      "STATUS=link up from 127.0.0.1:40000 at 1000.0 Hz, ignoring 3 datagrams/s from outside --allow-from, "
+      "2 readers");
+}
+
 TEST(ServiceNotifier, WithoutAWatchdogTurnsSendNothing) {
   NotifySocket socket;
   ServiceNotifier notifier;
