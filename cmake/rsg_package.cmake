@@ -67,7 +67,31 @@ file(WRITE ${pkg_dir}/copyright
   "License: Apache-2.0\n"
   " On Debian systems, the full text of the Apache License, Version 2.0 is in\n"
   " /usr/share/common-licenses/Apache-2.0.\n")
-set(RSG_PACKAGE_MAINTAINER "rsg maintainers <rsg@example.org>" CACHE STRING "The Maintainer field of the .deb")
+# The Maintainer field: whoever builds the package answers for it. -DRSG_PACKAGE_MAINTAINER="Name <address>",
+# else Debian's DEBFULLNAME and DEBEMAIL (as dch reads them), else the checkout's git user.name and
+# user.email; make package (its rsg_man target) fails rather than ship a made-up address, while a
+# plain build configures without one.
+if(NOT RSG_PACKAGE_MAINTAINER)
+  if(DEFINED ENV{DEBFULLNAME} AND DEFINED ENV{DEBEMAIL})
+    set(maintainer "$ENV{DEBFULLNAME} <$ENV{DEBEMAIL}>")
+  else()
+    execute_process(COMMAND git -C ${PROJECT_SOURCE_DIR} config user.name OUTPUT_VARIABLE git_name
+                    OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+    execute_process(COMMAND git -C ${PROJECT_SOURCE_DIR} config user.email OUTPUT_VARIABLE git_email
+                    OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+    if(git_name AND git_email)
+      set(maintainer "${git_name} <${git_email}>")
+    endif()
+  endif()
+  set(RSG_PACKAGE_MAINTAINER "${maintainer}" CACHE STRING "The Maintainer field of the .deb: Name <address>" FORCE)
+endif()
+if(RSG_PACKAGE_MAINTAINER MATCHES "^[^<>]+ <[^<>@ ]+@[^<>@ ]+>$")
+  add_custom_target(rsg_maintainer_check)
+else()
+  add_custom_target(rsg_maintainer_check
+    COMMAND ${CMAKE_COMMAND} -E echo "make package: the .deb needs a maintainer, 'Name <address>': -DRSG_PACKAGE_MAINTAINER=..., DEBFULLNAME and DEBEMAIL, or git config user.name and user.email (got '${RSG_PACKAGE_MAINTAINER}')"
+    COMMAND ${CMAKE_COMMAND} -E false)
+endif()
 # The date of the changelog entry: the last commit's (SOURCE_DATE_EPOCH when set), so that two builds
 # of one commit make the same file.
 if(DEFINED ENV{SOURCE_DATE_EPOCH})
@@ -85,10 +109,25 @@ add_custom_command(OUTPUT ${pkg_dir}/changelog.gz ${pkg_dir}/CHANGELOG.md.gz
   COMMAND gzip -9nc ${pkg_dir}/changelog > ${pkg_dir}/changelog.gz
   COMMAND gzip -9nc ${PROJECT_SOURCE_DIR}/CHANGELOG.md > ${pkg_dir}/CHANGELOG.md.gz
   DEPENDS ${pkg_dir}/changelog ${PROJECT_SOURCE_DIR}/CHANGELOG.md)
-add_custom_target(rsg_deb_docs DEPENDS ${pkg_dir}/changelog.gz ${pkg_dir}/CHANGELOG.md.gz)
-add_dependencies(rsg_man rsg_deb_docs)
-install(FILES ${pkg_dir}/copyright ${pkg_dir}/changelog.gz ${pkg_dir}/CHANGELOG.md.gz
+# The guides an operator of the service reads, which the unit's Documentation= names: compressed,
+# as Debian's policy wants anything of /usr/share/doc over 4 KB.
+set(RSG_DEB_GUIDES service troubleshooting configuration operating security)
+set(guide_files)
+foreach(guide ${RSG_DEB_GUIDES})
+  add_custom_command(OUTPUT ${pkg_dir}/${guide}.md.gz
+    COMMAND gzip -9nc ${PROJECT_SOURCE_DIR}/docs/${guide}.md > ${pkg_dir}/${guide}.md.gz
+    DEPENDS ${PROJECT_SOURCE_DIR}/docs/${guide}.md)
+  list(APPEND guide_files ${pkg_dir}/${guide}.md.gz)
+endforeach()
+add_custom_target(rsg_deb_docs DEPENDS ${pkg_dir}/changelog.gz ${pkg_dir}/CHANGELOG.md.gz ${guide_files})
+add_dependencies(rsg_man rsg_deb_docs rsg_maintainer_check)
+install(FILES ${pkg_dir}/copyright ${pkg_dir}/changelog.gz ${pkg_dir}/CHANGELOG.md.gz ${guide_files}
         DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/rsg COMPONENT deb EXCLUDE_FROM_ALL)
+# The alert rules and the dashboard, for Prometheus' rule_files and Grafana's file provisioning.
+install(FILES deploy/prometheus/rsg-alerts.yml DESTINATION ${CMAKE_INSTALL_DATADIR}/rsg/prometheus COMPONENT deb
+        EXCLUDE_FROM_ALL)
+install(FILES deploy/grafana/rsg-fleet.json DESTINATION ${CMAKE_INSTALL_DATADIR}/rsg/grafana COMPONENT deb
+        EXCLUDE_FROM_ALL)
 
 # Maintainer scripts: no system user (the unit has DynamicUser=yes); systemd reloaded, running
 # instances restarted on upgrade and stopped on removal; purge removes what systemd made for the

@@ -4,9 +4,9 @@ over loopback and the host's /dev/shm (what docker/compose.yaml sets).
   pipeline      rsg_sim -> rsg_gateway -> rsg_echo --json and rsg_record: every frame exact at the
                 echo, the MCAP file read by the reference reader (tests/tools/record/check_recording.mjs)
                 to the values sent
-  health        the image's HEALTHCHECK (GET /healthz on the gateway's metrics port): unhealthy
-                before the robot streams, healthy while rsg_sim streams, unhealthy again once it
-                stops; healthy in a container of another tool
+  health        the image's HEALTHCHECK (GET /livez on the gateway's metrics port): healthy
+                before, while and after rsg_sim streams, unhealthy while the gateway is frozen
+                (SIGSTOP), healthy again after; healthy in a container of another tool
   view_and_restart
                 rsg_view serves its page to Debian's headless Chromium on the host
                 (tests/tools/view/check_page.mjs): live samples rsg_sim sent, plotted by Chart.js; then
@@ -256,26 +256,36 @@ def pipeline(c):
 
 
 def health(c):
-    """The HEALTHCHECK follows /healthz: no robot yet, streaming, stopped. With podman each check is
-    run on demand (`podman healthcheck run`); Docker runs it every 10 s and says unhealthy after 3
-    failures, so there the waits are longer but the states the same."""
+    """The HEALTHCHECK follows /livez, the process's liveness: healthy whether the robot streams or
+    not (before, during, after), unhealthy while the gateway is frozen (SIGSTOP: its loop hands over
+    no snapshot, and the check's read times out), healthy again once it goes on. With podman each
+    check is run on demand (`podman healthcheck run`); Docker runs it every 10 s and says unhealthy
+    after 3 failures, so there the waits are longer but the states the same."""
     port = free_udp_port()
     c.gateway(port)
     wait_for_stats(c.stats, lambda s: True, "the gateway container to start", timeout_s=60)
     gateway = c.container("gateway")
-    check(c.name != "podman" or not healthy(c, gateway), "healthy before the robot sent a frame")
+    wait_for(lambda: healthy(c, gateway), "the HEALTHCHECK to pass before the robot sent a frame", timeout_s=60,
+             interval_s=1)
     c.start("sim", "--to", f"127.0.0.1:{port}", "--rate", "500", "--duration", "120", entrypoint="rsg_sim")
     wait_for_stats(c.stats, lambda s: s["frames_published"] > 0, "the gateway to publish", timeout_s=60)
-    wait_for(lambda: healthy(c, gateway), "the HEALTHCHECK to pass while rsg_sim streams", timeout_s=60, interval_s=1)
+    check(healthy(c, gateway) or c.name != "podman", "unhealthy while rsg_sim streams")
     check(c.stop("sim") == 0, f"rsg_sim did not exit 0 on SIGTERM: {c.stderr('sim')}")
-    wait_for(lambda: not healthy(c, gateway), "the HEALTHCHECK to fail once the frames stopped", timeout_s=60,
+    check(healthy(c, gateway) or c.name != "podman", "unhealthy once the robot stopped: a liveness check must not care")
+    c.engine_run("kill", "--signal", "STOP", gateway)
+    try:
+        wait_for(lambda: not healthy(c, gateway), "the HEALTHCHECK to fail while the gateway is frozen", timeout_s=60,
+                 interval_s=1)
+    finally:
+        c.engine_run("kill", "--signal", "CONT", gateway)
+    wait_for(lambda: healthy(c, gateway), "the HEALTHCHECK to pass once the gateway goes on", timeout_s=60,
              interval_s=1)
     # A container of another tool runs no gateway: healthy.
     c.start("echo", "--domain", c.domain, entrypoint="rsg_echo")
     wait_for(lambda: healthy(c, c.container("echo")), "the HEALTHCHECK to pass in a container without a gateway",
              timeout_s=60, interval_s=1)
-    print("[image] health: unhealthy before the robot, healthy while it streams, unhealthy after it stopped; "
-          "healthy without a gateway", flush=True)
+    print("[image] health: healthy before, while and after the robot streams, unhealthy while the gateway is "
+          "frozen, healthy again after; healthy without a gateway", flush=True)
 
 
 def dds_attacks(c):

@@ -1,7 +1,8 @@
 """--metrics, judged by the real Prometheus tools: `promtool check metrics` accepts the scrape, a real
 Prometheus server scraping every second reports the published-frame counter equal to the valid
-frames rsg_sim sent and the invalid counter per category equal to the invalid ones, /healthz is 200
-while the robot streams and 503 once it stops, and every expression of the Grafana dashboard
+frames rsg_sim sent and the invalid counter per category equal to the invalid ones, the ingress
+delay histogram counts every valid frame, /healthz and /readyz are 200 while the robot streams and
+503 before and after, /livez 200 throughout, and every expression of the Grafana dashboard
 evaluates on that server. Fails (never skips) when promtool or prometheus is missing."""
 
 import json
@@ -56,8 +57,11 @@ def body(h):
     prometheus = start_prometheus(h, metrics)
     wait_for(lambda: query(prometheus, 'up{job="rsg"} == 1'), "Prometheus to scrape the gateway once")
 
-    status, text = http_get(metrics, "/healthz")
-    check(status == 503, f"/healthz answered {status} before any frame (expected 503: the link is down)")
+    for path in ("/healthz", "/readyz"):
+        status, text = http_get(metrics, path)
+        check(status == 503, f"{path} answered {status} before any frame (expected 503: the link is down)")
+    status, text = http_get(metrics, "/livez")
+    check(status == 200, f"/livez answered {status} before any frame (expected 200: waiting for the robot is alive)")
 
     record, report_path = h.dir / "sim.record.jsonl", h.dir / "sim.report.json"
     sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{udp}", "--rate", RATE, "--count", str(COUNT),
@@ -72,6 +76,8 @@ def body(h):
     check(final["frames_published"] == report["valid"], f"published {final['frames_published']} of {report['valid']}")
     # ... and 503 once it stopped
     wait_for(lambda: (http_get(metrics, "/healthz") or (0,))[0] == 503, "/healthz 503 after the robot stopped")
+    check(http_get(metrics, "/readyz")[0] == 503 and http_get(metrics, "/livez")[0] == 200,
+          "after the robot stopped: /readyz not 503, or /livez not 200")
 
     # (a) promtool accepts the scrape, lint included, and the scrape says what the sim sent
     status, text = http_get(metrics, "/metrics")
@@ -86,6 +92,12 @@ def body(h):
     for category, count in report["invalid"].items():
         check(value_of(samples, "rsg_frames_invalid_total", gateway=NAME, category=category) == count,
               f"scrape: invalid {category}")
+    # The histograms count every valid frame, the +Inf bucket as many as _count.
+    for histogram in ("rsg_ingress_delay_seconds", "rsg_frame_age_seconds"):
+        count = value_of(samples, f"{histogram}_count", gateway=NAME)
+        check(value_of(samples, f"{histogram}_bucket", gateway=NAME, le="+Inf") == count, f"{histogram}: +Inf != count")
+    check(value_of(samples, "rsg_ingress_delay_seconds_count", gateway=NAME) == report["valid"],
+          "scrape: the ingress delay histogram did not count every valid frame")
 
     # (b) the real server's view, through its HTTP API, once a scrape after the last frame is in
     def counter(promql):
