@@ -87,7 +87,7 @@ class Containers:
         for path in (self.data, self.stats_dir):
             path.chmod(0o777)
         self.stats = self.stats_dir / "gateway-stats.json"
-        # The entrypoint's --metrics 127.0.0.1:$RSG_METRICS_PORT, where the HEALTHCHECK asks /healthz:
+        # The entrypoint's --metrics 127.0.0.1:$RSG_METRICS_PORT, where the HEALTHCHECK asks /livez:
         # a port of this run (the host network is shared with every other test's gateways).
         self.metrics_port = free_tcp_port()
         # Domains 210-233: none of ctest's (tests/support/test_domain.py: 20-99), one per case, so that no
