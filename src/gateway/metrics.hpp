@@ -38,8 +38,8 @@ struct MetricsSnapshot {
   bool has_ingress = false;
   std::optional<DumpCounts> dumps;  ///< with a flight recorder (--pcap-ring)
   DdsGuardCounts dds_guard;
-  LatencyHistogram ingress_delay;   ///< with ingress: arrival -> publication, every valid frame
-  LatencyHistogram frame_age;       ///< with ingress: the robot's time stamp -> publication (Ingress)
+  LatencyHistogram ingress_delay;  ///< with ingress: arrival -> publication, every valid frame
+  LatencyHistogram frame_age;      ///< with ingress: the robot's time stamp -> publication (Ingress)
   /// Unix time (s) of the last link change; the gateway's start before the first.
   double link_last_change_s = 0;
   /// The labels every series carries: `gateway` always (the gateway sets it to --name, the
