@@ -1,7 +1,7 @@
-// SIGINT and SIGTERM as a stop request (and SIGUSR1 as rsg_gateway's dump request) for every rsg
-// executable. The signals are blocked in every thread (block_stop_signals() runs before DDS starts
-// its threads) and taken synchronously by one thread of this object: no handler, no global flag, and
-// no async-signal-unsafe code in a signal handler.
+// SIGINT and SIGTERM as a stop request (and, for rsg_gateway, SIGUSR1 as a dump request and SIGHUP
+// as a reload request) for every rsg executable. The signals are blocked in every thread
+// (block_stop_signals() runs before DDS starts its threads) and taken synchronously by one thread
+// of this object: no handler, no global flag, and no async-signal-unsafe code in a signal handler.
 #pragma once
 
 #include <pthread.h>
@@ -15,25 +15,45 @@ namespace rsg::app {
 
 class StopOnSignal {
  public:
-  /// Blocks SIGINT and SIGTERM, and SIGUSR1 `with_dump`, in the calling thread and in every thread
-  /// it starts from then on. Call it first in main, before DDS starts its threads (Fast DDS 3 starts
-  /// some when the XML profiles load): a thread that leaves the signal unblocked can take it, and
-  /// discards it where it arrives ignored (a process started from a background job).
-  static void block_stop_signals(bool with_dump = false) {
-    const sigset_t signals = taken_signals(with_dump);
+  /// What a long-running service takes besides the stop signals (rsg_gateway).
+  struct ServiceSignals {
+    std::function<void()> on_dump;    ///< SIGUSR1
+    std::function<void()> on_reload;  ///< SIGHUP
+  };
+
+  /// Blocks SIGINT and SIGTERM, and SIGUSR1 and SIGHUP `with_service_signals`, in the calling
+  /// thread and in every thread it starts from then on. Call it first in main, before DDS starts its
+  /// threads (Fast DDS 3 starts some when the XML profiles load): a thread that leaves the signal
+  /// unblocked can take it, and discards it where it arrives ignored (a process started from a
+  /// background job). Without it, SIGHUP keeps its default action (the tools are not services).
+  /// A service also blocks SIGPIPE, which it never takes: a write to a closed connection then fails
+  /// with EPIPE instead of ending the process, a death systemd would count as a clean exit.
+  static void block_stop_signals(bool with_service_signals = false) {
+    sigset_t signals = taken_signals(with_service_signals);
+    if (with_service_signals) sigaddset(&signals, SIGPIPE);
     pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   }
 
-  /// Calls `on_stop` once, from this object's thread, when SIGINT or SIGTERM arrives; and `on_dump`
-  /// (when given: block_stop_signals(true) first) on every SIGUSR1 until then.
-  explicit StopOnSignal(std::function<void()> on_stop, std::function<void()> on_dump = {})
-      : thread_([on_stop = std::move(on_stop), on_dump = std::move(on_dump)](std::stop_token token) {
-          const sigset_t signals = taken_signals(static_cast<bool>(on_dump));
+  /// Calls `on_stop` once, from this object's thread, when SIGINT or SIGTERM arrives.
+  explicit StopOnSignal(std::function<void()> on_stop) : StopOnSignal(std::move(on_stop), false, {}) {}
+
+  /// The same, and until then `service.on_dump` on every SIGUSR1 and `service.on_reload` on every
+  /// SIGHUP (block_stop_signals(true) first).
+  StopOnSignal(std::function<void()> on_stop, ServiceSignals service)
+      : StopOnSignal(std::move(on_stop), true, std::move(service)) {}
+
+ private:
+  StopOnSignal(std::function<void()> on_stop, bool with_service_signals, ServiceSignals service)
+      : thread_([on_stop = std::move(on_stop), with_service_signals,
+                 service = std::move(service)](std::stop_token token) {
+          const sigset_t signals = taken_signals(with_service_signals);
           const timespec poll{0, 100'000'000};  // to notice the stop request
           while (!token.stop_requested()) {
             const int signal = sigtimedwait(&signals, nullptr, &poll);
             if (signal == SIGUSR1) {
-              on_dump();
+              if (service.on_dump) service.on_dump();
+            } else if (signal == SIGHUP) {
+              if (service.on_reload) service.on_reload();
             } else if (signal > 0) {
               on_stop();
               return;
@@ -41,13 +61,15 @@ class StopOnSignal {
           }
         }) {}
 
- private:
-  static sigset_t taken_signals(bool with_dump) {
+  static sigset_t taken_signals(bool with_service_signals) {
     sigset_t signals;
     sigemptyset(&signals);
     sigaddset(&signals, SIGINT);
     sigaddset(&signals, SIGTERM);
-    if (with_dump) sigaddset(&signals, SIGUSR1);
+    if (with_service_signals) {
+      sigaddset(&signals, SIGUSR1);
+      sigaddset(&signals, SIGHUP);
+    }
     return signals;
   }
 

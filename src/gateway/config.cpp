@@ -151,6 +151,34 @@ const std::array kKeys = {
               }},
     ConfigKey{"pcap-dir", "Directory the flight recorder's pcap files go to", &GatewayConfig::pcap_dir,
               [](const GatewayConfig&) { return std::string(); }},
+    ConfigKey{"pcap-min-interval",
+              "Flight recorder: at least SECONDS between two dumps, whether the link went down or SIGUSR1 "
+              "asked; a request sooner is not dumped and counted (result=\"throttled\"); 0: no limit",
+              &GatewayConfig::pcap_min_interval,
+              [](const GatewayConfig& c) {
+                return c.pcap_min_interval >= 0 && c.pcap_min_interval <= 86400 ? std::string()
+                                                                                : "must be in 0..86400";
+              }},
+    ConfigKey{"pcap-max-files",
+              "Flight recorder: keep at most this many of its files (rsg_flight_*.pcap) in --pcap-dir, "
+              "deleting the oldest first",
+              &GatewayConfig::pcap_max_files,
+              [](const GatewayConfig& c) {
+                return c.pcap_max_files >= 1 && c.pcap_max_files <= 100000 ? std::string()
+                                                                           : "must be in 1..100000";
+              }},
+    ConfigKey{"pcap-max-mb",
+              "Flight recorder: keep at most this many MiB of its files in --pcap-dir, deleting the oldest "
+              "first (a dump larger than that keeps its newest datagrams)",
+              &GatewayConfig::pcap_max_mb,
+              [](const GatewayConfig& c) {
+                return c.pcap_max_mb >= 1 && c.pcap_max_mb <= 1048576 ? std::string()
+                                                                      : "must be in 1..1048576";
+              }},
+    ConfigKey{"pcap-all-sources",
+              "Flight recorder: keep datagrams from outside --allow-from in the ring too (default: only "
+              "those --allow-from accepts, so that a flood from elsewhere cannot push the robot's out)",
+              &GatewayConfig::pcap_all_sources, [](const GatewayConfig&) { return std::string(); }},
     ConfigKey{"log-level", "trace, debug, info, warn, error or off", &GatewayConfig::log_level,
               [](const GatewayConfig& c) {
                 static constexpr std::array kLevels = {"trace", "debug", "info", "warn", "error", "off"};

@@ -57,6 +57,12 @@ struct GatewayConfig {
   // Flight recorder: the last pcap_ring seconds of raw datagrams, dumped into pcap_dir as pcap
   double pcap_ring = 0;  ///< seconds; 0: off
   std::string pcap_dir;
+  // Its bounds (docs/configuration.md): an outsider who can flap the link or send a flood cannot
+  // make it fill the disk. The defaults are safe to leave running for months.
+  double pcap_min_interval = 10;  ///< seconds at least between two dumps, whatever asks; 0: none
+  int pcap_max_files = 100;       ///< rsg's dump files kept in pcap_dir, oldest deleted first
+  int pcap_max_mb = 500;          ///< and their bytes, MiB
+  bool pcap_all_sources = false;  ///< also keep datagrams from outside allow-from in the ring
 
   // Real-time mode of the ingress thread (src/gateway/realtime.hpp: what each needs)
   int rt_priority = 0;  ///< SCHED_FIFO priority 1..99, with mlockall; 0: off

@@ -43,17 +43,27 @@ void FlightRecorder::lend(transport::DatagramBatch& batch) {
 }
 
 void FlightRecorder::commit(const transport::DatagramBatch& batch, std::size_t received,
-                            std::chrono::system_clock::time_point now) {
+                            std::chrono::system_clock::time_point now, const SourceFilter& sources) {
   const auto time = std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch());
+  std::size_t kept = 0;
   for (std::size_t i = 0; i < received; ++i) {
     const transport::DatagramBatch::Datagram datagram = batch[i];
-    Entry& entry = entries_[(next_ + i) % slots_];
+    if (!options_.all_sources && !sources.allows(datagram.from.address())) {
+      ++not_kept_;
+      continue;
+    }
+    // Datagram i sits in the i-th lent slot; a skipped one before it leaves a gap to close. The
+    // slot it moves to held a datagram already handled and not kept (or moved on itself).
+    const std::size_t index = (next_ + kept) % slots_;
+    if (kept != i) std::memcpy(slot(index), datagram.bytes.data(), datagram.bytes.size());
+    Entry& entry = entries_[index];
     entry.time = time;
     entry.size = static_cast<std::uint32_t>(datagram.bytes.size());
     entry.from = capture::endpoint_of(datagram.from.address());
+    ++kept;
   }
-  next_ = (next_ + received) % slots_;
-  count_ = std::min(count_ + received, kept_capacity_);
+  next_ = (next_ + kept) % slots_;
+  count_ = std::min(count_ + kept, kept_capacity_);
 }
 
 FlightRecorder::Snapshot FlightRecorder::snapshot(std::string_view reason) {
@@ -95,6 +105,25 @@ FlightRecorder::Dump FlightRecorder::write(const Snapshot& snapshot) {
   }
   writer.flush();
   return result;
+}
+
+// A pcap file: its 24-byte header, then per datagram a 16-byte record header and the IP packet
+// (at most kMaxIpUdpHeader bytes of IPv6 and UDP headers in front of the payload).
+std::uintmax_t FlightRecorder::file_bytes(const Snapshot& snapshot, std::size_t first) {
+  std::uintmax_t total = 24;
+  for (std::size_t i = first; i < snapshot.datagrams.size(); ++i)
+    total += 16 + capture::kMaxIpUdpHeader + snapshot.datagrams[i].size;
+  return total;
+}
+
+std::size_t FlightRecorder::keep_newest(Snapshot& snapshot, std::uintmax_t max_bytes) {
+  std::uintmax_t total = file_bytes(snapshot);
+  std::size_t first = 0;
+  while (first < snapshot.datagrams.size() && total > max_bytes)
+    total -= 16 + capture::kMaxIpUdpHeader + snapshot.datagrams[first++].size;
+  snapshot.datagrams.erase(snapshot.datagrams.begin(),
+                           snapshot.datagrams.begin() + static_cast<std::ptrdiff_t>(first));
+  return first;
 }
 
 }  // namespace rsg::gateway

@@ -4,9 +4,12 @@
 //
 // The ring is allocated at start-up, and the ingress receives straight into it
 // (DatagramBatch::receive_into): recording costs per frame no allocation and no copy, only a
-// timestamp and the sender's address. Only a dump allocates: the ingress thread copies the window's
-// datagrams out of the ring (`snapshot`), and another thread writes the file (`write`, DumpWriter),
-// so that a slow or hung disk never holds frames in the socket's buffer.
+// timestamp and the sender's address. Datagrams from outside --allow-from are not kept (unless
+// `all_sources`): a flood from elsewhere would push the robot's seconds out of the ring and fill
+// every dump with the attacker's bytes; the robot's are moved up over their slots instead. Only a dump
+// allocates: the ingress thread copies the window's datagrams out of the ring (`snapshot`), and another
+// thread writes the file (`write`, DumpWriter), so that a slow or hung disk never holds frames in the
+// socket's buffer.
 #pragma once
 
 #include <chrono>
@@ -17,6 +20,7 @@
 #include <vector>
 
 #include "rsg/transport/udp_socket.hpp"
+#include "source_filter.hpp"
 #include "udp_packet.hpp"
 
 namespace rsg::gateway {
@@ -27,6 +31,7 @@ class FlightRecorder {
     std::chrono::duration<double> window{};  ///< how far back a dump reaches
     double expected_rate = 1000;             ///< sizes the ring: twice this rate over the window
     std::filesystem::path dir;               ///< where dumps go
+    bool all_sources = false;                ///< keep datagrams `commit`'s filter rejects too
   };
 
   struct Dump {
@@ -60,9 +65,14 @@ class FlightRecorder {
 
   /// Before a receive: the batch's datagrams will land in the ring's next free slots.
   void lend(transport::DatagramBatch& batch);
-  /// After it: the `received` datagrams of `batch` become the newest entries, seen at `now`.
+  /// After it, once the batch's datagrams are handled (kept ones may move over skipped ones): the
+  /// `received` datagrams of `batch` that `sources` allows (all with `all_sources`) become the
+  /// newest entries, seen at `now`.
   void commit(const transport::DatagramBatch& batch, std::size_t received,
-              std::chrono::system_clock::time_point now);
+              std::chrono::system_clock::time_point now, const SourceFilter& sources);
+
+  /// Datagrams `commit` did not keep (from outside `sources`) since start.
+  std::uint64_t not_kept() const { return not_kept_; }
 
   /// Copies the datagrams of the last `window` before the newest one, oldest first, and names
   /// their file. Allocates: call it on a request or a link change, never per frame.
@@ -70,6 +80,12 @@ class FlightRecorder {
 
   /// Writes `snapshot` as a pcap file. @throws rsg::EnvironmentError when it cannot.
   static Dump write(const Snapshot& snapshot);
+
+  /// At least the size of the file `write` makes of `snapshot` from its datagram `first` on.
+  static std::uintmax_t file_bytes(const Snapshot& snapshot, std::size_t first = 0);
+  /// Drops the oldest datagrams of `snapshot` until its file takes at most `max_bytes`; returns
+  /// how many it dropped.
+  static std::size_t keep_newest(Snapshot& snapshot, std::uintmax_t max_bytes);
 
  private:
   struct Entry {
@@ -90,6 +106,7 @@ class FlightRecorder {
   std::size_t next_ = 0;   // the slot the next datagram goes to
   std::size_t count_ = 0;  // valid entries, ending just before next_
   std::uint64_t dumps_ = 0;
+  std::uint64_t not_kept_ = 0;
 };
 
 }  // namespace rsg::gateway

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 
 #include "credentials.hpp"
 #include "errno_text.hpp"
@@ -221,8 +222,9 @@ GatewaySetup prepare(const GatewayConfig& config) {
     if (config.requests_selection()) ingress.requested_selection = requested_selection(config);
     if (!config.robot.empty()) ingress.robot = resolve("robot", config.robot);
     if (config.pcap_ring > 0) {
-      ingress.flight_recorder = FlightRecorder::Options{std::chrono::duration<double>(config.pcap_ring),
-                                                        config.expected_rate, config.pcap_dir};
+      ingress.flight_recorder =
+          FlightRecorder::Options{std::chrono::duration<double>(config.pcap_ring), config.expected_rate,
+                                  config.pcap_dir, config.pcap_all_sources};
     }
     setup.ingress = std::move(ingress);
   }
@@ -250,7 +252,11 @@ Gateway::Gateway(const GatewaySetup& setup)
       stats_file_(config_.stats_file) {
   if (setup.ingress) {
     ingress_.emplace(participant_, *setup.ingress);
-    if (ingress_->has_flight_recorder()) dump_writer_.emplace();
+    if (ingress_->has_flight_recorder())
+      dump_writer_.emplace(DumpWriter::Options{config_.pcap_dir,
+                                               std::chrono::duration<double>(config_.pcap_min_interval),
+                                               static_cast<std::size_t>(config_.pcap_max_files),
+                                               static_cast<std::uintmax_t>(config_.pcap_max_mb) << 20});
     spdlog::info("ingress: frames on UDP {} -> topic '{}' (domain {})",
                  ingress_->local_endpoint().to_string(), setup.ingress->topic, config_.domain);
     if (const auto& standard = setup.ingress->standard_topics) {
@@ -273,7 +279,8 @@ Gateway::Gateway(const GatewaySetup& setup)
   }
 }
 
-void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump, LoopObserver* observer) {
+void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump, LoopObserver* observer,
+                  PendingReload* reload) {
   const auto start = Clock::now();
   if (ingress_) {
     ingress_->start(start);
@@ -301,6 +308,7 @@ void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump, LoopOb
     const auto now = Clock::now();
     if (ingress_ && ingress_->link_changed(now)) on_link_change();
     if (dump != nullptr && dump->exchange(false)) dump_flight_recorder("signal");
+    if (reload != nullptr) take_reload(*reload);
     if (now >= next_status) {
       const GatewayStats stats = on_status_period(now);
       if (observer != nullptr) observer->status(stats, ingress_.has_value());
@@ -331,9 +339,87 @@ void Gateway::dump_flight_recorder(std::string_view reason) {
     return;
   }
   // The copy here, the file on the dump writer's thread: this is the ingress thread.
-  if (!dump_writer_->post(std::string(reason), [&] { return *ingress_->flight_recorder_snapshot(reason); }))
-    spdlog::error("flight recorder ({}): not dumped, {} earlier dumps are still being written", reason,
-                  DumpWriter::kMaxPending);
+  const auto now = Clock::now();
+  switch (dump_writer_->post(std::string(reason), now,
+                             [&] { return *ingress_->flight_recorder_snapshot(reason); })) {
+    case DumpWriter::Posted::kQueued:
+      break;
+    case DumpWriter::Posted::kThrottled:  // counted; a flapping link or a signal flood logs once a minute
+      if (dump_throttled_log_.allow(now))
+        spdlog::warn(
+            "flight recorder ({}): not dumped, less than --pcap-min-interval {} s after the last dump "
+            "({} such requests since start)",
+            reason, config_.pcap_min_interval, dump_writer_->throttled());
+      break;
+    case DumpWriter::Posted::kRefused:
+      if (dump_refused_log_.allow(now))
+        spdlog::error(
+            "flight recorder ({}): not dumped, {} earlier dumps are still being written ({} refused "
+            "since start)",
+            reason, DumpWriter::kMaxPending, dump_writer_->refused());
+      break;
+  }
+}
+
+void PendingReload::offer(Read read) {
+  const std::lock_guard lock(mutex_);
+  read_ = std::move(read);
+  offered_.store(true, std::memory_order_release);
+}
+
+std::optional<PendingReload::Read> PendingReload::take() {
+  if (!offered_.exchange(false, std::memory_order_acquire)) return std::nullopt;
+  const std::lock_guard lock(mutex_);
+  return std::exchange(read_, std::nullopt);
+}
+
+void Gateway::take_reload(PendingReload& pending) {
+  std::optional<PendingReload::Read> read = pending.take();
+  if (!read) return;
+  try {
+    if (const auto* why = std::get_if<std::string>(&*read)) throw InputError(*why);
+    reload(std::get<GatewayConfig>(*read));
+    ++reloads_.applied;
+  } catch (const InputError& error) {
+    ++reloads_.failed;
+    spdlog::error("SIGHUP: configuration not reloaded, the running one stays: {}", error.what());
+  }
+  if (metrics_) metrics_->publish(metrics_snapshot(snapshot(), Clock::now()));
+}
+
+void Gateway::reload(const GatewayConfig& fresh) {
+  if (auto problem = check_config(fresh)) throw InputError(*problem);
+  SourceFilter sources;
+  for (const auto& network : fresh.allow_from) {
+    const wire::Parsed<Network> parsed = parse_network(network);
+    if (!parsed) throw InputError("--allow-from: " + parsed.error());
+    sources.allow(*parsed);
+  }
+  // Every key that differs: the two a running gateway can take, and the rest, named.
+  std::vector<std::string> applied, need_restart;
+  for (const ConfigKey& key : config_keys()) {
+    const bool differs =
+        std::visit([&](auto member) { return config_.*member != fresh.*member; }, key.member);
+    if (!differs) continue;
+    if (key.name == "allow-from")
+      applied.push_back(fmt::format("allow-from [{}] (was [{}])", fmt::join(fresh.allow_from, ", "),
+                                    fmt::join(config_.allow_from, ", ")));
+    else if (key.name == "log-level")
+      applied.push_back(fmt::format("log-level {} (was {})", fresh.log_level, config_.log_level));
+    else
+      need_restart.push_back("--" + std::string(key.name));
+  }
+  if (ingress_) ingress_->set_sources(std::move(sources));
+  config_.allow_from = fresh.allow_from;
+  spdlog::info("SIGHUP: configuration reloaded: {}", applied.empty()
+                                                         ? std::string("allow-from and log-level unchanged")
+                                                         : fmt::format("{}", fmt::join(applied, ", ")));
+  if (!need_restart.empty())
+    spdlog::warn("SIGHUP: not applied until a restart: {} (a reload applies allow-from and log-level)",
+                 fmt::join(need_restart, ", "));
+  // Last, so that lowering the level does not hide the lines above.
+  config_.log_level = fresh.log_level;
+  spdlog::set_level(spdlog::level::from_str(fresh.log_level));
 }
 
 GatewayStats Gateway::on_status_period(Clock::time_point now) {
@@ -369,7 +455,10 @@ MetricsSnapshot Gateway::metrics_snapshot(const GatewayStats& stats, Clock::time
   metrics.stats = stats;
   metrics.has_ingress = ingress_.has_value();
   if (dump_writer_)
-    metrics.dumps = DumpCounts{dump_writer_->written(), dump_writer_->failed(), dump_writer_->refused()};
+    metrics.dumps =
+        DumpCounts{dump_writer_->written(),   dump_writer_->failed(),  dump_writer_->refused(),
+                   dump_writer_->throttled(), dump_writer_->deleted(), ingress_->flight_recorder_not_kept()};
+  metrics.reloads = reloads_;
   const dds::RtpsGuardCounts& guard = participant_.rtps_guard();
   metrics.dds_guard = DdsGuardCounts{guard.statistics_removed.load(std::memory_order_relaxed),
                                      guard.statistics_misplaced.load(std::memory_order_relaxed),

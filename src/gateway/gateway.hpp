@@ -6,7 +6,10 @@
 #pragma once
 
 #include <atomic>
+#include <mutex>
 #include <optional>
+#include <string>
+#include <variant>
 
 #include "config.hpp"
 #include "dump_writer.hpp"
@@ -34,6 +37,22 @@ struct GatewaySetup {
 /// @throws rsg::InputError with a message naming the flag, file or profile at fault.
 GatewaySetup prepare(const GatewayConfig& config);
 
+/// A configuration re-read for SIGHUP on the signal's thread, handed to the loop, which never
+/// reads files: the configuration, or why it could not be read.
+class PendingReload {
+ public:
+  using Read = std::variant<GatewayConfig, std::string>;
+  /// Any thread; a newer offer replaces one not taken yet.
+  void offer(Read read);
+  /// The loop's thread: what was offered since the last call, if anything.
+  std::optional<Read> take();
+
+ private:
+  std::atomic<bool> offered_{false};  // checked every turn without the lock
+  std::mutex mutex_;
+  std::optional<Read> read_;  // guarded by mutex_
+};
+
 class Gateway {
  public:
   /// Binds, creates the DDS entities and starts egress.
@@ -45,8 +64,14 @@ class Gateway {
   /// set, then writes the final status. Whenever `dump` (when given) is set, it clears it and
   /// hands a flight-recorder dump to the dump writer's thread. `observer` (when given) hears of
   /// the start, every turn of the loop and every status period, on this thread.
-  void run(const std::atomic<bool>& stop, std::atomic<bool>* dump = nullptr,
-           LoopObserver* observer = nullptr);
+  /// Whenever `reload` (when given) holds a configuration, applies it (`reload`).
+  void run(const std::atomic<bool>& stop, std::atomic<bool>* dump = nullptr, LoopObserver* observer = nullptr,
+           PendingReload* reload = nullptr);
+
+  /// Applies what of `fresh` can change while running -- allow-from and log-level -- and logs it,
+  /// and names every other key that differs as needing a restart.
+  /// @throws rsg::InputError when `fresh` does not pass check_config; nothing changes then.
+  void reload(const GatewayConfig& fresh);
 
   /// Where ingress receives frames; nothing when there is no ingress.
   std::optional<transport::Endpoint> ingress_endpoint() const {
@@ -56,6 +81,7 @@ class Gateway {
  private:
   void on_link_change();
   void dump_flight_recorder(std::string_view reason);
+  void take_reload(PendingReload& reload);
   GatewayStats on_status_period(Clock::time_point now);  // returns the stats it reported
   GatewayStats snapshot() const;
   MetricsSnapshot metrics_snapshot(const GatewayStats& stats, Clock::time_point now) const;
@@ -71,9 +97,12 @@ class Gateway {
   std::optional<NoLinkWarning> no_link_;   // with ingress
   StatsFile stats_file_;                   // --stats-file, written by a thread of its own
   std::optional<DumpWriter> dump_writer_;  // with a flight recorder: writes its dumps
-  double link_last_change_s_ = 0;          // Unix time, for the metrics
-  std::string gateway_label_;              // the metrics' `gateway` label
-  std::optional<MetricsServer> metrics_;   // last: serves snapshots of everything above
+  LogThrottle dump_throttled_log_{std::chrono::minutes(1)};
+  LogThrottle dump_refused_log_{std::chrono::minutes(1)};
+  ReloadCounts reloads_;
+  double link_last_change_s_ = 0;         // Unix time, for the metrics
+  std::string gateway_label_;             // the metrics' `gateway` label
+  std::optional<MetricsServer> metrics_;  // last: serves snapshots of everything above
 };
 
 /// Puts the calling thread (the one that will call `Gateway::run`) in the configured real-time

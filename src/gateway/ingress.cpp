@@ -123,11 +123,12 @@ void Ingress::receive(std::chrono::milliseconds timeout) {
     // Every datagram of a batch was queued by now: one clock reading serves them all.
     const auto now = Clock::now();
     const auto wall_now = std::chrono::system_clock::now();
-    if (recorder_ && received) recorder_->commit(batch_, received, wall_now);
     for (std::size_t i = 0; i < received; ++i) {
       const transport::DatagramBatch::Datagram datagram = batch_[i];
       handle(datagram, now, arrival_of(datagram.arrived, now, wall_now));
     }
+    // After handling: keeping only allowed senders' datagrams moves bytes within the batch's slots.
+    if (recorder_ && received) recorder_->commit(batch_, received, wall_now, options_.sources);
     if (received < batch_.capacity()) return;  // the queue was empty; the next poll waits for more
   }
 }
@@ -142,9 +143,8 @@ void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::
   ++counters_.received;
 
   // Longer than any frame, so never valid; decoding the part that fit could pass it off as a
-  // valid frame of that length. Counted as the spec's length check counts such datagrams
-  // (length_mismatch); only a forged length field above kMaxDataBytes that matches the real size
-  // and fails the CRC would rank bad_crc first, and the cut-off bytes cannot tell.
+  // valid frame of that length. length_mismatch, as docs/protocol.md's step 1 ranks it for every
+  // decoder, whatever the cut-off bytes held.
   if (datagram.truncated) {
     reject({wire::ErrorCategory::kLengthMismatch, "%zu bytes, longer than any frame (%zu)", datagram.size,
             wire::kMaxFrameBytes},
@@ -233,6 +233,8 @@ void Ingress::request_selection(const transport::Endpoint& robot, Clock::time_po
   else
     spdlog::warn("could not send the selection request to {}", robot.to_string());
 }
+
+void Ingress::set_sources(SourceFilter sources) { options_.sources = std::move(sources); }
 
 std::optional<FlightRecorder::Snapshot> Ingress::flight_recorder_snapshot(std::string_view reason) {
   if (!recorder_) return std::nullopt;

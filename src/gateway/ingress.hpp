@@ -109,6 +109,11 @@ class Ingress {
   /// is off. Allocates: call it on a request or a link change, not per frame.
   std::optional<FlightRecorder::Snapshot> flight_recorder_snapshot(std::string_view reason);
   bool has_flight_recorder() const { return recorder_.has_value(); }
+  /// Datagrams from outside --allow-from the flight recorder did not keep; 0 without one.
+  std::uint64_t flight_recorder_not_kept() const { return recorder_ ? recorder_->not_kept() : 0; }
+
+  /// Accepts frames from `sources` from the next datagram on (SIGHUP's reload of allow-from).
+  void set_sources(SourceFilter sources);
 
   /// The standard ROS 2 topics, when any is on.
   const Ros2StandardTopics* standard_topics() const {

@@ -1,5 +1,9 @@
 // rsg_gateway: raw SEND_BUF frames over UDP <-> RobotState DDS samples. See gateway.hpp.
 //
+// Signals: SIGINT and SIGTERM stop it (final stats written), SIGUSR1 asks for a flight-recorder dump,
+// SIGHUP re-reads the configuration (--config and the flags over it) and applies what can change
+// while running (allow-from, log-level; Gateway::reload), naming the rest as needing a restart.
+//
 // Exit status (src/app/tool_main.hpp, as every rsg executable): 0 after SIGINT/SIGTERM, 2 when the
 // configuration (flags, file, profiles, addresses) is unusable, 1 when the machine refuses (the port
 // is taken, DDS refuses an entity); nothing is left running then. A refused real-time setting
@@ -91,7 +95,7 @@ GatewayConfig read_config(const std::string& config_file, const GatewayConfig& f
 int main(int argc, char** argv) {
   rsg::app::init_logging("rsg_gateway");
   rsg::gateway::use_journal_priorities();  // under systemd: each line's level as its journal priority
-  StopOnSignal::block_stop_signals(/*with_dump=*/true);
+  StopOnSignal::block_stop_signals(/*with_service_signals=*/true);
   CLI::App app("rsg_gateway: robot-state frames over UDP <-> RobotState DDS samples", "rsg_gateway");
   app.footer(kRealtimeHelp);
   app.set_version_flag("--version",
@@ -107,16 +111,27 @@ int main(int argc, char** argv) {
     spdlog::set_level(spdlog::level::from_str(config.log_level));
     if (config.log_format == "json") rsg::gateway::use_json_log_lines();  // every line from here on
     const rsg::gateway::GatewaySetup setup = rsg::gateway::prepare(config);
-    // SIGUSR1 asks for a flight-recorder dump: the loop takes it when it sees `dump`.
+    // SIGUSR1 asks for a flight-recorder dump: the loop takes it when it sees `dump`. SIGHUP's
+    // configuration is read here, on the signal's thread (the loop never waits on a file), and
+    // applied by the loop.
     std::atomic<bool> stop{false};
     std::atomic<bool> dump{false};
-    const StopOnSignal signals([&stop] { stop = true; }, [&dump] { dump = true; });
+    rsg::gateway::PendingReload reload;
+    const auto reread = [&] {
+      try {
+        reload.offer(read_config(config_file, flags_only, argc, argv));
+      } catch (const std::exception& error) {  // a bad file must not end a running gateway
+        reload.offer(std::string(error.what()));
+      }
+    };
+    const StopOnSignal signals([&stop] { stop = true; },
+                               StopOnSignal::ServiceSignals{[&dump] { dump = true; }, reread});
     rsg::gateway::Gateway gateway(setup);
     // Started: from here on a log of a running service, with times (but for the journal's own).
     if (config.log_format != "json") rsg::app::log_with_timestamps();
     rsg::gateway::enter_realtime_mode(config);
     rsg::gateway::ServiceNotifier systemd;  // READY, STATUS and the watchdog under a Type=notify unit
-    gateway.run(stop, &dump, &systemd);
+    gateway.run(stop, &dump, &systemd, &reload);
     return kExitOk;
   });
 }

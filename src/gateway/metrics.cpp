@@ -52,9 +52,21 @@ constexpr Family kEgressUnencodable{"rsg_egress_unencodable_total", Type::kCount
                                     "Egress samples that describe no valid frame"};
 constexpr Family kEgressSendFailed{"rsg_egress_send_failed_total", Type::kCounter,
                                    "Egress datagrams the socket refused"};
-constexpr Family kDumps{"rsg_flight_recorder_dumps_total", Type::kCounter,
-                        "Flight-recorder dumps by result: written, failed (the file could not be written) or "
-                        "refused (earlier dumps were still being written)"};
+constexpr Family kDumps{
+    "rsg_flight_recorder_dumps_total", Type::kCounter,
+    "Flight-recorder dumps by result: written, failed (the file could not be written), "
+    "refused (earlier dumps were still being written) or throttled (asked for sooner than "
+    "--pcap-min-interval after the last one)"};
+constexpr Family kDumpFilesDeleted{
+    "rsg_flight_recorder_files_deleted_total", Type::kCounter,
+    "Flight-recorder files deleted, oldest first, to stay within --pcap-max-files "
+    "and --pcap-max-mb"};
+constexpr Family kDumpNotKept{"rsg_flight_recorder_datagrams_not_kept_total", Type::kCounter,
+                              "Datagrams from outside --allow-from the flight recorder left out of its ring "
+                              "(--pcap-all-sources keeps them)"};
+constexpr Family kReloads{"rsg_config_reloads_total", Type::kCounter,
+                          "Configuration reloads on SIGHUP by result: applied, or failed (the running "
+                          "configuration stayed)"};
 constexpr Family kDdsGuard{
     "rsg_dds_guard_total", Type::kCounter,
     "What the DDS transport guard did: statistics_removed (the statistics submessage "
@@ -100,7 +112,10 @@ constexpr std::array kFamilies = {&kBuildInfo,
                                   &kEgressUnencodable,
                                   &kEgressSendFailed,
                                   &kDumps,
+                                  &kDumpFilesDeleted,
+                                  &kDumpNotKept,
                                   &kDdsGuard,
+                                  &kReloads,
                                   &kLinkUp,
                                   &kLinkChange,
                                   &kRate,
@@ -278,12 +293,18 @@ std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<
     out.sample(kDumps, dumps->written, "result=\"written\"");
     out.sample(kDumps, dumps->failed, "result=\"failed\"");
     out.sample(kDumps, dumps->refused, "result=\"refused\"");
+    out.sample(kDumps, dumps->throttled, "result=\"throttled\"");
+    out.one(kDumpFilesDeleted, dumps->files_deleted);
+    out.one(kDumpNotKept, dumps->not_kept);
   }
   out.family(kDdsGuard);
   out.sample(kDdsGuard, snapshot.dds_guard.statistics_removed, "action=\"statistics_removed\"");
   out.sample(kDdsGuard, snapshot.dds_guard.statistics_misplaced, "action=\"statistics_misplaced\"");
   out.sample(kDdsGuard, snapshot.dds_guard.send_channels_opened, "action=\"send_channel_opened\"");
   out.sample(kDdsGuard, snapshot.dds_guard.destinations_skipped, "action=\"destination_skipped\"");
+  out.family(kReloads);
+  out.sample(kReloads, snapshot.reloads.applied, "result=\"applied\"");
+  out.sample(kReloads, snapshot.reloads.failed, "result=\"failed\"");
 
   out.one(kLinkUp, stats.link_up ? 1 : 0);
   out.one(kLinkChange, snapshot.link_last_change_s);

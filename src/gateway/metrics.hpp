@@ -21,8 +21,17 @@ namespace rsg::gateway {
 /// The flight recorder's dumps since start, by how they ended (DumpWriter).
 struct DumpCounts {
   std::uint64_t written = 0;
-  std::uint64_t failed = 0;   ///< the file could not be written
-  std::uint64_t refused = 0;  ///< not taken: earlier dumps were still being written
+  std::uint64_t failed = 0;         ///< the file could not be written
+  std::uint64_t refused = 0;        ///< not taken: earlier dumps were still being written
+  std::uint64_t throttled = 0;      ///< not taken: sooner than --pcap-min-interval after the last
+  std::uint64_t files_deleted = 0;  ///< oldest files deleted for --pcap-max-files / --pcap-max-mb
+  std::uint64_t not_kept = 0;       ///< datagrams from outside --allow-from left out of the ring
+};
+
+/// SIGHUP's reloads of the configuration since start (Gateway::reload).
+struct ReloadCounts {
+  std::uint64_t applied = 0;
+  std::uint64_t failed = 0;  ///< the file did not read or check: the running configuration stayed
 };
 
 /// What the transport guard of the gateway's participant did (rsg/dds/rtps_guard.hpp).
@@ -40,6 +49,7 @@ struct MetricsSnapshot {
   DdsGuardCounts dds_guard;
   LatencyHistogram ingress_delay;  ///< with ingress: arrival -> publication, every valid frame
   LatencyHistogram frame_age;      ///< with ingress: the robot's time stamp -> publication (Ingress)
+  ReloadCounts reloads;
   /// Unix time (s) of the last link change; the gateway's start before the first.
   double link_last_change_s = 0;
   /// The labels every series carries: `gateway` always (the gateway sets it to --name, the

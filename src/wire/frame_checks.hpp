@@ -261,6 +261,13 @@ class FrameDecoder {
                kMinFrameBytes};
       return result;
     }
+    // Longer than the longest frame: length_mismatch whatever the bytes say, so that a receiver
+    // whose buffer holds one frame (the gateway's) and one that sees every byte agree.
+    if (bytes.size() > kMaxFrameBytes) {
+      error = {ErrorCategory::kLengthMismatch, "%zu bytes, longer than any frame (%zu)", bytes.size(),
+               kMaxFrameBytes};
+      return result;
+    }
     const std::uint16_t length = read_u16(bytes.data() + 1);
     const std::size_t expected = kMinFrameBytes + length;
     if (bytes.size() != expected) {

@@ -52,6 +52,7 @@ def main():
     realtime = ["--rt-priority", "30"] if realtime_prefix() else []
     gateway = subprocess.Popen([str(args.bin / "rsg_gateway"), "--listen", f"127.0.0.1:{port}", "--expected-rate",
                                 "1000", "--pcap-ring", str(args.window), "--pcap-dir", str(work / "dumps"),
+                                "--pcap-min-interval", "0",  # a dump every round, on purpose
                                 "--stats-file", str(stats), "--domain", str(acquire_domain()), *realtime],
                                stdout=subprocess.DEVNULL, stderr=open(work / "gateway.err", "w"))
     seconds = args.window + 3 + args.rounds * 2 * (WINDOW_S + 0.5) + 5

@@ -17,8 +17,12 @@ from harness import TestFailure, check, free_udp_port, main, wait_for_stats  # n
 DEPLOY = Path(__file__).resolve().parents[2] / "deploy" / "systemd"
 MAX_EXPOSURE = 2.0
 PROMISES = ["Type=notify", "NotifyAccess=main", "WatchdogSec=", "Restart=on-failure", "StartLimitBurst=",
-            "RestartPreventExitStatus=2", "DynamicUser=yes", "Group=rsg", "Documentation=man:rsg_gateway(1)", "RuntimeDirectory=rsg/%i", "ProtectSystem=strict", "NoNewPrivileges=yes",
-            "ExecStart=/usr/bin/rsg_gateway --config /etc/rsg/%i.yaml --name %i"]
+            "RestartPreventExitStatus=2", "DynamicUser=yes", "Group=rsg", "Documentation=man:rsg_gateway(1)",
+            "RuntimeDirectory=rsg/%i", "ProtectSystem=strict", "NoNewPrivileges=yes",
+            "ExecStart=/usr/bin/rsg_gateway --config /etc/rsg/%i.yaml --name %i",
+            "ExecReload=/bin/kill -HUP $MAINPID"]
+# The example's flight recorder is bounded (docs/configuration.md): safe to leave running.
+BOUNDED_RECORDER = ["pcap-min-interval:", "pcap-max-files:", "pcap-max-mb:"]
 
 
 def settings(path):
@@ -57,6 +61,10 @@ def body(h):
     exposure = float(match.group(1))
     print(f"systemd-analyze security: {exposure} {match.group(2)}")
     check(exposure <= MAX_EXPOSURE, f"exposure {exposure} {match.group(2)} > {MAX_EXPOSURE} (see {h.dir}/security.txt)")
+
+    example = settings(DEPLOY / "robot1.yaml")
+    for key in BOUNDED_RECORDER:
+        check(any(line.startswith(key) for line in example), f"robot1.yaml's flight recorder lacks {key}")
 
     # The example configuration, with this test's ports and directories instead of the unit's.
     pcap_dir = h.dir / "pcap"

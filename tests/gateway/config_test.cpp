@@ -252,5 +252,22 @@ TEST(GatewayConfig, FlightRecorderNeedsADirectoryAndAListeningSocket) {
   EXPECT_NE(check_config(broken)->find("--pcap-ring needs --listen"), std::string::npos);
 }
 
+TEST(GatewayConfig, FlightRecorderIsBoundedByDefaultAndItsBoundsAreChecked) {
+  const GatewayConfig defaults;
+  EXPECT_EQ(defaults.pcap_min_interval, 10);
+  EXPECT_EQ(defaults.pcap_max_files, 100);
+  EXPECT_EQ(defaults.pcap_max_mb, 500);
+  EXPECT_FALSE(defaults.pcap_all_sources);
+  const GatewayConfig config =
+      parse_ok("pcap-min-interval: 0\npcap-max-files: 3\npcap-max-mb: 1\npcap-all-sources: true\n");
+  EXPECT_EQ(config.pcap_min_interval, 0);
+  EXPECT_EQ(config.pcap_max_files, 3);
+  EXPECT_EQ(config.pcap_max_mb, 1);
+  EXPECT_TRUE(config.pcap_all_sources);
+  EXPECT_FALSE(parse_gateway_config("pcap-min-interval: -1\n"));
+  EXPECT_FALSE(parse_gateway_config("pcap-max-files: 0\n"));
+  EXPECT_FALSE(parse_gateway_config("pcap-max-mb: 0\n"));
+}
+
 }  // namespace
 }  // namespace rsg::gateway

@@ -77,7 +77,8 @@ def body(h):
     dumps.mkdir()
     metrics = free_tcp_port()
     gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", str(RATE),
-                               "--pcap-ring", "1", "--pcap-dir", str(dumps), "--metrics", f"127.0.0.1:{metrics}")
+                               "--pcap-ring", "1", "--pcap-dir", str(dumps), "--metrics", f"127.0.0.1:{metrics}",
+                               "--pcap-min-interval", "0")  # every request dumps: the limits are attack_*'s
     wait_for_stats(stats, lambda s: True, "the gateway to start")
     sent_capture = h.dir / "sent.pcap"
     status = h.run("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", str(RATE), "--count",
@@ -92,7 +93,8 @@ def body(h):
     on_signal = wait_for(lambda: sorted(dumps.glob("*_signal.pcap")), "the dump on SIGUSR1")[0]
     stuck_dump_writer(h, gateway, stats, port, dumps)
     # Every dump counted by how it ended: all written (the files in the folder), one refused.
-    wait_for(lambda: dump_counts(metrics) == {"written": len(list(dumps.glob("*.pcap"))), "failed": 0, "refused": 1},
+    wait_for(lambda: dump_counts(metrics) == {"written": len(list(dumps.glob("*.pcap"))), "failed": 0, "refused": 1,
+                                             "throttled": 0},
              f"rsg_flight_recorder_dumps_total to count the dumps (it says {dump_counts(metrics)})")
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
 

@@ -1,4 +1,5 @@
-// Loads the conformance vectors kept as delivered in tests/data/vectors.
+// Loads the conformance vectors kept as delivered in tests/data/vectors, and rsg's own
+// (oversized.jsonl: datagrams longer than any frame, docs/protocol.md step 1).
 #pragma once
 
 #include <fstream>
@@ -36,6 +37,12 @@ inline std::vector<Vector> load_vectors(const std::string& file, const char* key
 }
 
 inline std::vector<Vector> valid_vectors() { return load_vectors("valid.jsonl", "decoded"); }
-inline std::vector<Vector> invalid_vectors() { return load_vectors("invalid.jsonl", "error"); }
+inline std::vector<Vector> oversized_vectors() { return load_vectors("oversized.jsonl", "error"); }
+/// The delivered invalid vectors, then rsg's oversized ones: every decoder must agree on all.
+inline std::vector<Vector> invalid_vectors() {
+  std::vector<Vector> vectors = load_vectors("invalid.jsonl", "error");
+  for (Vector& vector : oversized_vectors()) vectors.push_back(std::move(vector));
+  return vectors;
+}
 
 }  // namespace rsg::test

@@ -16,7 +16,8 @@ namespace {
 
 TEST(Vectors, AreAllThere) {
   EXPECT_EQ(test::valid_vectors().size(), 94U);
-  EXPECT_EQ(test::invalid_vectors().size(), 29U);
+  EXPECT_EQ(test::load_vectors("invalid.jsonl", "error").size(), 29U);
+  EXPECT_EQ(test::oversized_vectors().size(), 7U);
 }
 
 TEST(Vectors, ValidFramesDecodeToTheExpectedValues) {

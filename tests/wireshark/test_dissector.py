@@ -31,6 +31,11 @@ def load_jsonl(name):
     return [json.loads(line) for line in (VECTORS / name).read_text().splitlines() if line.strip()]
 
 
+def invalid_vectors():
+    """The delivered invalid vectors, then rsg's own oversized ones (docs/protocol.md, step 1)."""
+    return load_jsonl("invalid.jsonl") + load_jsonl("oversized.jsonl")
+
+
 def table_fields():
     """(name, type) of every field, as the generated dissector's table lists them."""
     text = tshark_run.DISSECTOR.read_text()
@@ -144,7 +149,7 @@ class Dissector(unittest.TestCase):
         self.assertIn("CRC status: Good (1)", [line.strip("[]") for line in lines])
 
     def test_every_invalid_vector_reports_its_category_as_error_and_expert_info(self):
-        vectors = load_jsonl("invalid.jsonl")
+        vectors = invalid_vectors()
         capture = self.capture("invalid.pcap", [(bytes.fromhex(v["frame_hex"]), 40000, PORT) for v in vectors])
         rows = tshark_run.fields(capture, ["frame.number", "sendbuf.error", "_ws.expert.message"])
         self.assertEqual(len(rows), len(vectors))
@@ -158,6 +163,20 @@ class Dissector(unittest.TestCase):
             flagged = tshark_run.fields(capture, ["frame.number"], display_filter=f"sendbuf.expert.{category}")
             expected = [str(n) for n, v in enumerate(vectors, start=1) if v["error"] == category]
             self.assertEqual([r["frame.number"][0] for r in flagged], expected, category)
+
+    def test_an_oversized_datagram_cut_by_the_capture_keeps_its_category(self):
+        # As the gateway's flight recorder stores one: the first 2137 bytes, the real size in the
+        # record header and in the UDP header. The category is the one the gateway counted.
+        path = Path(self.dir.name) / "cut.pcap"
+        vectors = load_jsonl("oversized.jsonl")
+        with open(path, "wb") as out:
+            out.write(struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, pcap_file.LINKTYPE_IPV4))
+            for number, vector in enumerate(vectors):
+                packet = pcap_file.ipv4_udp(bytes.fromhex(vector["frame_hex"]), 40000, PORT)
+                kept = packet[:20 + 8 + 2137]
+                out.write(struct.pack("<IIII", 1000, number * 1000, len(kept), len(packet)) + kept)
+        rows = tshark_run.fields(path, ["sendbuf.error"])
+        self.assertEqual([row["sendbuf.error"] for row in rows], [["length_mismatch"]] * len(vectors))
 
     def test_selection_request_is_flagged_and_keeps_the_decoders_verdict(self):
         request = frame(0x35, 0x04, [0, 0, 0x20, 0, 0, 0])  # asks for q

@@ -24,6 +24,7 @@ local REQUEST_TYPE = 3
 local GROUP_COUNT = 6
 local MAX_ROBOT_MODE = 6
 local ERROR_FLAG_COUNT = 37
+local MAX_FRAME_BYTES = 2137
 -- Validation categories in the order the spec checks them.
 local ERROR_CATEGORIES = { "truncated", "length_mismatch", "bad_crc", "bad_request", "reserved_bits", "selection_mismatch", "bad_value" }
 -- The field table in field-index order (the order of the data section).
@@ -262,6 +263,12 @@ end
 local function validate(tvb)
   local n = tvb:len()
   if n < MIN_FRAME_BYTES then return "truncated", "only " .. n .. " bytes" end
+  -- The datagram's real size, even when the capture kept only its first bytes (the gateway's
+  -- flight recorder keeps one frame's worth).
+  local size = tvb:reported_len()
+  if size > MAX_FRAME_BYTES then
+    return "length_mismatch", size .. " bytes, longer than any frame (" .. MAX_FRAME_BYTES .. ")"
+  end
   local length = tvb(1, 2):le_uint()
   if n < MIN_FRAME_BYTES + length then
     return "truncated", n .. " bytes, the length field needs " .. (MIN_FRAME_BYTES + length)

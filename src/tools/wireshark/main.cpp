@@ -56,6 +56,7 @@ std::string tables() {
   lua << "local GROUP_COUNT = " << rsg::wire::kGroupCount << "\n";
   lua << "local MAX_ROBOT_MODE = " << unsigned{rsg::wire::kMaxRobotMode} << "\n";
   lua << "local ERROR_FLAG_COUNT = " << rsg::wire::kErrorFlagCount << "\n";
+  lua << "local MAX_FRAME_BYTES = " << rsg::wire::kMaxFrameBytes << "\n";
   lua << "-- Validation categories in the order the spec checks them.\nlocal ERROR_CATEGORIES = {";
   for (std::size_t i = 1; i < rsg::wire::kErrorCategoryNames.size(); ++i)
     lua << (i == 1 ? " " : ", ") << quoted(rsg::wire::kErrorCategoryNames[i]);

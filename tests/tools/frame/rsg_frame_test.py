@@ -26,6 +26,11 @@ def load_jsonl(name):
         return [json.loads(line) for line in lines if line.strip()]
 
 
+def invalid_vectors():
+    """The delivered invalid vectors, then rsg's own oversized ones (docs/protocol.md, step 1)."""
+    return load_jsonl("invalid.jsonl") + load_jsonl("oversized.jsonl")
+
+
 def run(*args, stdin=b""):
     """Runs the tool; returns (exit status, stdout bytes, stderr text)."""
     done = subprocess.run([TOOL, *args], input=stdin, capture_output=True, timeout=60, check=False)
@@ -72,7 +77,7 @@ class Decode(unittest.TestCase):
             self.assert_same(decoded, vector["decoded"])
 
     def test_hex_lines_report_the_category_of_every_invalid_vector(self):
-        vectors = load_jsonl("invalid.jsonl")
+        vectors = invalid_vectors()
         for report, vector in zip(self.decode_hex_lines(vectors), vectors):
             self.assertEqual(list(report), ["error", "message"])
             self.assertEqual(report["error"], vector["error"])
@@ -122,7 +127,7 @@ class Decode(unittest.TestCase):
             self.assert_same(json.loads(out), vector["decoded"])
 
     def test_invalid_binary_frame_exits_1_with_its_category(self):
-        for vector in load_jsonl("invalid.jsonl"):
+        for vector in invalid_vectors():
             status, out, err = run("decode", stdin=bytes.fromhex(vector["frame_hex"]))
             self.assertEqual((status, out), (1, b""))
             self.assertTrue(err.startswith(f"error: {vector['error']}: "), err)
