@@ -30,6 +30,12 @@ std::string check_optional_host_port(const std::string& value) {
   return value.empty() ? std::string() : check_host_port(value, transport::HostPortRule::kPortRequired);
 }
 
+std::string check_range(int value, int low, int high) {
+  return value >= low && value <= high
+             ? ""
+             : std::to_string(value) + " is not in " + std::to_string(low) + ".." + std::to_string(high);
+}
+
 std::string check_not_empty(const std::string& value) { return value.empty() ? "must not be empty" : ""; }
 
 // The first complaint of `parse` (a parser returning wire::Parsed) about one of `values`, or "".
@@ -142,6 +148,25 @@ const std::array kKeys = {
               "This gateway's name: the `gateway` label of its metrics (default: the partition, else the "
               "host's name)",
               &GatewayConfig::name, [](const GatewayConfig&) { return std::string(); }},
+    ConfigKey{"metrics-max-connections",
+              "Connections --metrics holds open at once; at the limit the oldest one still waiting for its "
+              "request makes room (docs/security.md)",
+              &GatewayConfig::metrics_max_connections,
+              [](const GatewayConfig& c) { return check_range(c.metrics_max_connections, 1, 10000); }},
+    ConfigKey{
+        "metrics-max-connections-per-client",
+        "Connections --metrics holds open per client IP address, as for --metrics-max-connections",
+        &GatewayConfig::metrics_max_connections_per_client,
+        [](const GatewayConfig& c) { return check_range(c.metrics_max_connections_per_client, 1, 10000); }},
+    ConfigKey{"metrics-header-timeout-ms",
+              "Time a --metrics client has to send its request's header, from connecting or from the "
+              "first byte of a request on a kept-alive connection",
+              &GatewayConfig::metrics_header_timeout_ms,
+              [](const GatewayConfig& c) { return check_range(c.metrics_header_timeout_ms, 10, 600000); }},
+    ConfigKey{"metrics-idle-timeout-ms",
+              "Time a kept-alive --metrics connection may wait for its next request",
+              &GatewayConfig::metrics_idle_timeout_ms,
+              [](const GatewayConfig& c) { return check_range(c.metrics_idle_timeout_ms, 10, 3600000); }},
     ConfigKey{"pcap-ring",
               "Flight recorder: keep the last SECONDS of raw datagrams in memory and write them as a pcap "
               "file into --pcap-dir on SIGUSR1 and when the link goes down; 0: off",

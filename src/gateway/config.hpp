@@ -53,6 +53,10 @@ struct GatewayConfig {
   // Monitoring: Prometheus metrics and /healthz on HOST:PORT (metrics_server.hpp); "" : off
   std::string metrics;
   std::string name;  ///< the `gateway` label of the metrics; "" : the partition, else the host's name
+  int metrics_max_connections = 32;
+  int metrics_max_connections_per_client = 8;
+  int metrics_header_timeout_ms = 5000;
+  int metrics_idle_timeout_ms = 15000;
 
   // Flight recorder: the last pcap_ring seconds of raw datagrams, dumped into pcap_dir as pcap
   double pcap_ring = 0;  ///< seconds; 0: off

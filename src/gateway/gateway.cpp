@@ -273,7 +273,12 @@ Gateway::Gateway(const GatewaySetup& setup)
   link_last_change_s_ = unix_now_s();
   gateway_label_ = gateway_label(config_);
   if (setup.metrics) {
-    metrics_.emplace(MetricsServer::Options{*setup.metrics}, metrics_snapshot(snapshot(), Clock::now()));
+    MetricsServer::Options options{*setup.metrics};
+    options.max_connections = static_cast<std::size_t>(config_.metrics_max_connections);
+    options.max_connections_per_client = static_cast<std::size_t>(config_.metrics_max_connections_per_client);
+    options.header_timeout = std::chrono::milliseconds(config_.metrics_header_timeout_ms);
+    options.idle_timeout = std::chrono::milliseconds(config_.metrics_idle_timeout_ms);
+    metrics_.emplace(options, metrics_snapshot(snapshot(), Clock::now()));
     spdlog::info("metrics: /metrics, /livez and /readyz on {} (TCP port {})", config_.metrics,
                  metrics_->port());
   }

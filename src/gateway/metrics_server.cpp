@@ -1,8 +1,10 @@
 #include "metrics_server.hpp"
 
+#include <fmt/format.h>
 #include <pthread.h>
 #include <spdlog/spdlog.h>
 
+#include <array>
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/post.hpp>
@@ -14,6 +16,7 @@
 #include <thread>
 
 #include "http_reply.hpp"
+#include "log_throttle.hpp"
 #include "rsg/error.hpp"
 #include "tcp_listener.hpp"
 
@@ -30,43 +33,122 @@ constexpr std::string_view kExpositionType = "text/plain; version=0.0.4; charset
 
 using SnapshotPointer = std::shared_ptr<const MetricsSnapshot>;
 
-/// What the I/O thread's connections share.
+/// Why the server closed a connection itself: the `reason` label of rsg_http_connections_closed_total.
+enum class Closed : std::size_t { kPerClientLimit, kTotalLimit, kHeaderTimeout, kIdleTimeout, kCount };
+constexpr std::array<std::string_view, static_cast<std::size_t>(Closed::kCount)> kClosedReasons = {
+    "per_client_limit", "total_limit", "header_timeout", "idle_timeout"};
+constexpr auto kLimitLogInterval = std::chrono::minutes(1);
+
+/// What the I/O thread's connections share. I/O thread only, but for the options and snapshot.
 struct Shared {
+  explicit Shared(const MetricsServer::Options& options)
+      : options(options), table({options.max_connections, options.max_connections_per_client}) {}
+
   MetricsServer::Options options;
   std::atomic<SnapshotPointer> snapshot;
-  std::size_t connections = 0;  // I/O thread only
+  app::ConnectionTable table;
+  std::array<std::uint64_t, kClosedReasons.size()> closed{};
+  std::array<LogThrottle, kClosedReasons.size()> throttles{
+      LogThrottle(kLimitLogInterval), LogThrottle(kLimitLogInterval), LogThrottle(kLimitLogInterval),
+      LogThrottle(kLimitLogInterval)};
+
+  /// Counts a connection the server closed, and says so at most once a minute.
+  void count(Closed reason) {
+    const auto i = static_cast<std::size_t>(reason);
+    ++closed[i];
+    if (throttles[i].allow(Clock::now()))
+      spdlog::warn(
+          "metrics: {} connection(s) closed so far by {} (limits: {} connections, {} per client, header in "
+          "{} "
+          "ms, next request within {} ms)",
+          closed[i], kClosedReasons[i], options.max_connections, options.max_connections_per_client,
+          options.header_timeout.count(), options.idle_timeout.count());
+  }
 };
 
+/// The server's own families, appended to format_metrics' text with the same labels.
+std::string format_server_metrics(const MetricsSnapshot& snapshot, const Shared& shared) {
+  std::string labels;
+  if (!snapshot.gateway.empty()) labels += "gateway=\"" + escape_label_value(snapshot.gateway) + "\",";
+  if (!snapshot.partition.empty()) labels += "partition=\"" + escape_label_value(snapshot.partition) + "\",";
+  std::string out =
+      "# HELP rsg_http_connections_open Connections open to --metrics\n"
+      "# TYPE rsg_http_connections_open gauge\n";
+  const std::string common = labels.empty() ? "" : '{' + labels.substr(0, labels.size() - 1) + '}';
+  out += fmt::format("rsg_http_connections_open{} {}\n", common, shared.table.size());
+  out +=
+      "# HELP rsg_http_connections_closed_total Connections to --metrics the server closed by a limit: "
+      "per_client_limit, total_limit (an older waiting connection made room, or none could and the new one "
+      "was refused), header_timeout, idle_timeout\n"
+      "# TYPE rsg_http_connections_closed_total counter\n";
+  for (std::size_t i = 0; i < kClosedReasons.size(); ++i)
+    out += fmt::format("rsg_http_connections_closed_total{{{}reason=\"{}\"}} {}\n", labels, kClosedReasons[i],
+                       shared.closed[i]);
+  return out;
+}
+
 /// One HTTP connection, alive while a read or write of it is pending.
-class Session : public std::enable_shared_from_this<Session> {
+class Session : public std::enable_shared_from_this<Session>, public app::ConnectionTable::Member {
  public:
-  Session(tcp::socket&& socket, Shared& shared) : stream_(std::move(socket)), shared_(shared) {
-    ++shared_.connections;
+  Session(tcp::socket&& socket, Shared& shared, const net::ip::address& address)
+      : stream_(std::move(socket)), shared_(shared) {
+    slot_.join(shared_.table, address, *this);
   }
-  ~Session() { --shared_.connections; }
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
 
+  /// A new connection: its first request's header within the header timeout.
+  void start() { read_request(); }
+
+  /// After an answer on a kept-alive connection: the next request starts within the idle timeout.
   void read() {
+    if (buffer_.size() > 0) return read_request();  // pipelined: already begun
+    slot_.waiting(true);
+    stream_.expires_after(shared_.options.idle_timeout);
+    stream_.async_read_some(buffer_.prepare(kFirstRead),
+                            [self = shared_from_this()](beast::error_code ec, std::size_t size) {
+                              if (ec) return self->drop(ec, Closed::kIdleTimeout);
+                              self->buffer_.commit(size);
+                              self->read_request();
+                            });
+  }
+
+  void evict() override {
+    beast::error_code ignored;
+    stream_.socket().shutdown(tcp::socket::shutdown_both, ignored);
+    stream_.socket().close(ignored);
+  }
+
+ private:
+  static constexpr std::size_t kFirstRead = 512;
+
+  void read_request() {
+    slot_.waiting(true);
     parser_.emplace();
     parser_->header_limit(MetricsServer::kMaxRequestHeader);
     parser_->body_limit(kMaxRequestBody);
     // The whole request within the timeout: a client that sends a byte a second is closed too.
-    stream_.expires_after(MetricsServer::kRequestTimeout);
+    stream_.expires_after(shared_.options.header_timeout);
     http::async_read(stream_, buffer_, *parser_,
                      [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
   }
 
- private:
+  /// Ends the connection after a failed read; a timeout is counted as `timeout`.
+  void drop(beast::error_code ec, Closed timeout) {
+    if (ec == beast::error::timeout) shared_.count(timeout);
+    slot_.leave();
+    beast::error_code ignored;
+    stream_.socket().shutdown(tcp::socket::shutdown_both, ignored);
+  }
+
   void on_read(beast::error_code ec) {
+    slot_.waiting(false);
     if (ec) {
       // Too long a header answers 431; anything else (timeout, a closed or garbled connection) is dropped.
       if (ec == http::error::header_limit)
         return respond(11, false, http::status::request_header_fields_too_large,
                        "request header too large\n");
-      beast::error_code ignored;
-      stream_.socket().shutdown(tcp::socket::shutdown_both, ignored);
-      return;
+      return drop(ec, Closed::kHeaderTimeout);
     }
     const auto& request = parser_->get();
     const unsigned version = request.version();
@@ -80,7 +162,9 @@ class Session : public std::enable_shared_from_this<Session> {
     const SnapshotPointer snapshot = shared_.snapshot.load();
     if (target == "/metrics")
       return respond(version, keep_alive, http::status::ok,
-                     head ? std::string() : format_metrics(*snapshot, read_process_figures()),
+                     head ? std::string()
+                          : format_metrics(*snapshot, read_process_figures()) +
+                                format_server_metrics(*snapshot, shared_),
                      kExpositionType);
     if (target == "/livez" || target == "/readyz" || target == "/healthz") {
       // /healthz: /readyz's older name, kept for the health checks that use it.
@@ -98,13 +182,14 @@ class Session : public std::enable_shared_from_this<Session> {
 
   void respond(unsigned version, bool keep_alive, http::status status, std::string body,
                std::string_view type = "text/plain; charset=utf-8") {
-    stream_.expires_after(MetricsServer::kRequestTimeout);
+    stream_.expires_after(shared_.options.header_timeout);
     app::write_http_reply(shared_from_this(), stream_, "rsg_gateway", version, keep_alive,
                           {status, type, std::move(body)});
   }
 
   beast::tcp_stream stream_;
   Shared& shared_;
+  app::ConnectionTable::Slot slot_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
 };
@@ -119,40 +204,39 @@ tcp::endpoint to_asio(const transport::Endpoint& endpoint) {
 }  // namespace
 
 struct MetricsServer::Impl {
-  Shared shared;  // first: the sessions the context destroys last still count themselves out of it
+  explicit Impl(const Options& options) : shared(options) {}
+
+  Shared shared;  // first: the sessions the context destroys last still leave its table
   net::io_context io{1};
   tcp::acceptor acceptor{io};
+  app::AcceptLoop accepting{acceptor, "metrics",
+                            [this](tcp::socket socket) { on_connection(std::move(socket)); },
+                            [this] { shared.table.evict_oldest_waiting(); }};
   std::thread thread;
-  std::uint64_t refused = 0;
 
-  void accept() {
-    acceptor.async_accept([this](beast::error_code ec, tcp::socket socket) {
-      if (ec == net::error::operation_aborted) return;
-      if (!ec) {
-        if (shared.connections < shared.options.max_connections) {
-          std::make_shared<Session>(std::move(socket), shared)->read();
-        } else {
-          // Over the cap: closed at once. Logged once per power of two, not per connection.
-          ++refused;
-          if ((refused & (refused - 1)) == 0)
-            spdlog::warn("metrics: {} connection(s) refused so far: {} already open", refused,
-                         shared.options.max_connections);
-          beast::error_code ignored;
-          socket.close(ignored);
-        }
-      }
-      accept();
-    });
+  void on_connection(tcp::socket socket) {
+    beast::error_code ec;
+    const auto remote = socket.remote_endpoint(ec);
+    if (ec) return;  // gone already
+    const auto admission = shared.table.make_room(remote.address());
+    if (admission.limit)
+      shared.count(*admission.limit == app::ConnectionLimit::kPerAddress ? Closed::kPerClientLimit
+                                                                         : Closed::kTotalLimit);
+    if (!admission.admitted) {
+      // Every open connection is being answered: this one is closed at once.
+      socket.close(ec);
+      return;
+    }
+    std::make_shared<Session>(std::move(socket), shared, remote.address())->start();
   }
 };
 
 MetricsServer::MetricsServer(const Options& options, MetricsSnapshot first)
-    : impl_(std::make_unique<Impl>()) {
-  impl_->shared.options = options;
+    : impl_(std::make_unique<Impl>(options)) {
   impl_->shared.snapshot.store(std::make_shared<const MetricsSnapshot>(std::move(first)));
   if (const auto ec = rsg::app::listen_on(impl_->acceptor, to_asio(options.listen)))
     throw EnvironmentError("--metrics: cannot listen on " + options.listen.to_string() + ": " + ec.message());
-  impl_->accept();
+  impl_->accepting.start();
   impl_->thread = std::thread([impl = impl_.get()] {
     ::pthread_setname_np(::pthread_self(), "rsg-metrics");
     impl->io.run();
@@ -164,8 +248,7 @@ MetricsServer::~MetricsServer() {
   // destroys them on this thread, once the I/O thread has returned.
   std::promise<void> closed;
   net::post(impl_->io, [impl = impl_.get(), &closed] {
-    beast::error_code ignored;
-    impl->acceptor.close(ignored);
+    impl->accepting.stop();
     closed.set_value();
   });
   closed.get_future().wait();
@@ -178,5 +261,9 @@ void MetricsServer::publish(MetricsSnapshot snapshot) {
 }
 
 std::uint16_t MetricsServer::port() const { return impl_->acceptor.local_endpoint().port(); }
+
+std::vector<std::string> MetricsServer::family_names() {
+  return {"rsg_http_connections_open", "rsg_http_connections_closed_total"};
+}
 
 }  // namespace rsg::gateway

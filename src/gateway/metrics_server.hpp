@@ -7,14 +7,20 @@
 //
 // The ingress thread never waits for the HTTP side: `publish` swaps in a new snapshot (an atomic
 // shared pointer) and returns; the I/O thread formats it when a scraper asks. Bad clients cost the
-// I/O thread only: request headers are capped (kMaxRequestHeader), a request must arrive whole
-// within kRequestTimeout, and at most Options::max_connections connections are open at once
-// (more are closed as soon as they are accepted).
+// I/O thread only, and never keep /healthz from answering: request headers are capped
+// (kMaxRequestHeader); a request must arrive whole within Options::header_timeout and the next one
+// on a kept-alive connection start within Options::idle_timeout; connections are capped per client
+// address and in total, and at a cap the oldest connection still waiting for its request makes
+// room (app::ConnectionTable), so a probe that connects and asks at once is answered however many
+// slow or idle connections are open. Each limit that bites is counted on /metrics
+// (rsg_http_connections_closed_total{reason}) and logged at most once a minute.
 #pragma once
 
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "metrics.hpp"
 #include "rsg/transport/udp_socket.hpp"
@@ -26,12 +32,16 @@ class MetricsServer {
   struct Options {
     transport::Endpoint listen;  ///< port 0: any free port (see port())
     std::size_t max_connections = 32;
+    std::size_t max_connections_per_client = 8;  ///< per client IP address
+    /// From accept (or a kept-alive request's first byte) to the end of the request's header.
+    std::chrono::milliseconds header_timeout = std::chrono::seconds(5);
+    /// A kept-alive connection's wait for the first byte of its next request.
+    std::chrono::milliseconds idle_timeout = std::chrono::seconds(15);
     /// A snapshot older than this makes /livez and /readyz answer 503: the loop that takes them is stuck.
     Clock::duration max_snapshot_age = std::chrono::seconds(3);
   };
 
   static constexpr std::size_t kMaxRequestHeader = 8 * 1024;
-  static constexpr auto kRequestTimeout = std::chrono::seconds(5);
 
   /// Binds and starts serving. Throws rsg::EnvironmentError when the address cannot be bound.
   MetricsServer(const Options& options, MetricsSnapshot first);
@@ -43,6 +53,9 @@ class MetricsServer {
   void publish(MetricsSnapshot snapshot);
 
   std::uint16_t port() const;
+
+  /// The metric families the server adds to format_metrics' (metrics.hpp).
+  static std::vector<std::string> family_names();
 
  private:
   struct Impl;

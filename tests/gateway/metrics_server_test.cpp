@@ -35,10 +35,16 @@ MetricsServer::Options loopback() {
   return options;
 }
 
-// A blocking client connection.
+// A blocking client connection, from `source` (any 127.0.0.0/8 address: another client).
 class Client {
  public:
-  explicit Client(std::uint16_t port) : fd_(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0)) {
+  explicit Client(std::uint16_t port, const char* source = "127.0.0.1")
+      : fd_(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0)) {
+    sockaddr_in from{};
+    from.sin_family = AF_INET;
+    ::inet_pton(AF_INET, source, &from.sin_addr);
+    if (::bind(fd_, reinterpret_cast<const sockaddr*>(&from), sizeof from) != 0)
+      throw std::runtime_error("cannot bind");
     sockaddr_in address{};
     address.sin_family = AF_INET;
     address.sin_port = htons(port);
@@ -141,36 +147,73 @@ TEST(MetricsServer, AHeaderOverTheLimitIsRefusedAndTheConnectionClosed) {
   EXPECT_TRUE(response.starts_with("HTTP/1.1 431 ")) << response.substr(0, 100);
 }
 
-TEST(MetricsServer, ConnectionsOverTheCapAreClosedWhileTheOthersAreServed) {
+// The value of one rsg_http_connections_closed_total series in a /metrics answer, or -1.
+long closed_count(const std::string& response, const std::string& reason) {
+  const std::string key = "reason=\"" + reason + "\"} ";
+  const auto at = response.find(key, response.find("\nrsg_http_connections_closed_total{"));
+  return at == std::string::npos ? -1 : std::stol(response.substr(at + key.size()));
+}
+
+// Waits until the server has accepted what was connected (the counts are the I/O thread's).
+void settle() { ::usleep(200000); }
+
+TEST(MetricsServer, AtTheCapTheOldestWaitingConnectionMakesRoomForAProbe) {
   MetricsServer server(loopback(), snapshot(true));
   std::vector<std::unique_ptr<Client>> idle;
   for (int i = 0; i < 4; ++i) idle.push_back(std::make_unique<Client>(server.port()));
-  // The cap is reached once the server has accepted them; a fifth is closed unanswered.
-  std::string refused;
-  for (int attempt = 0; attempt < 50 && refused.empty(); ++attempt) {
-    Client extra(server.port());
-    extra.send("GET /metrics HTTP/1.1\r\nHost: x\r\n\r\n");
-    if (extra.read_all(1000ms).empty() && extra.closed()) refused = "closed";
-  }
-  EXPECT_EQ(refused, "closed");
-  idle.clear();  // the server notices the closed ones and serves again
-  std::string served;
-  for (int attempt = 0; attempt < 50 && served.empty(); ++attempt) {
-    const auto response = get(server.port(), "/healthz");
-    if (response.starts_with("HTTP/1.1 200"))
-      served = response;
-    else
-      ::usleep(100000);
-  }
-  EXPECT_FALSE(served.empty());
+  settle();
+  const auto probe = get(server.port(), "/healthz");
+  EXPECT_TRUE(probe.starts_with("HTTP/1.1 200 OK\r\n")) << probe;
+  EXPECT_EQ(idle.front()->read_all(1000ms), "");
+  EXPECT_TRUE(idle.front()->closed()) << "the oldest idle connection was not the one closed";
+  EXPECT_FALSE((idle.back()->read_all(100ms), idle.back()->closed()));
+  EXPECT_GE(closed_count(get(server.port(), "/metrics"), "total_limit"),
+            1);  // the probe (and this, if the probe is still open)
 }
 
-TEST(MetricsServer, AClientThatNeverFinishesItsRequestIsClosedAfterTheTimeout) {
-  MetricsServer server(loopback(), snapshot(true));
+TEST(MetricsServer, OneClientAtItsCapClosesItsOwnOldestConnectionsNotOthers) {
+  MetricsServer::Options options = loopback();
+  options.max_connections = 8;
+  options.max_connections_per_client = 2;
+  MetricsServer server(options, snapshot(true));
+  Client other1(server.port(), "127.0.0.3"), other2(server.port(), "127.0.0.3");
+  std::vector<std::unique_ptr<Client>> attacker;
+  for (int i = 0; i < 6; ++i) attacker.push_back(std::make_unique<Client>(server.port(), "127.0.0.2"));
+  settle();
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(attacker[i]->read_all(500ms), "");
+    EXPECT_TRUE(attacker[i]->closed()) << i;
+  }
+  EXPECT_FALSE((other1.read_all(100ms), other1.closed()));
+  EXPECT_FALSE((other2.read_all(100ms), other2.closed()));
+  Client probe(server.port(), "127.0.0.2");
+  probe.send("GET /metrics HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+  EXPECT_EQ(closed_count(probe.read_all(), "per_client_limit"), 5);
+}
+
+TEST(MetricsServer, AClientThatNeverFinishesItsRequestIsClosedAfterTheHeaderTimeout) {
+  MetricsServer::Options options = loopback();
+  options.header_timeout = 300ms;
+  MetricsServer server(options, snapshot(true));
   Client slow(server.port());
   slow.send("GET /metrics HTTP/1.1\r\n");  // and nothing more
-  EXPECT_EQ(slow.read_all(MetricsServer::kRequestTimeout + 5s), "");
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(slow.read_all(5000ms), "");
   EXPECT_TRUE(slow.closed()) << "the server still holds a request that never ends";
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 3s);
+  EXPECT_EQ(closed_count(get(server.port(), "/metrics"), "header_timeout"), 1);
+}
+
+TEST(MetricsServer, AKeptAliveConnectionWithoutANextRequestIsClosedAfterTheIdleTimeout) {
+  MetricsServer::Options options = loopback();
+  options.idle_timeout = 300ms;
+  MetricsServer server(options, snapshot(true));
+  Client client(server.port());
+  client.send("GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n");
+  const auto response = client.read_all(1500ms);
+  EXPECT_TRUE(response.starts_with("HTTP/1.1 200 OK\r\n")) << response;
+  EXPECT_TRUE(client.closed()) << "kept alive past the idle timeout";
+  EXPECT_EQ(closed_count(get(server.port(), "/metrics"), "idle_timeout"), 1);
 }
 
 TEST(MetricsServer, APortThatIsTakenIsAnEnvironmentError) {

@@ -45,7 +45,12 @@ struct Options : rsg::app::MonitorOptions {
   double page_rate_hz = 30;
   std::string chart_js = RSG_CHART_JS;
   rsg::tools::view::ServerOptions server;
+  double handshake_timeout_s = 10, idle_timeout_s = 60, stall_timeout_s = 20;
 };
+
+std::chrono::milliseconds milliseconds_of(double seconds) {
+  return std::chrono::milliseconds(static_cast<std::int64_t>(seconds * 1000));
+}
 
 std::uint64_t now_ns() {
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -70,6 +75,37 @@ void add_options(CLI::App& app, Options& options) {
   rsg::app::add_monitor_options(app, options, "serves none");
   app.add_option("--max-clients", options.server.max_clients, "WebSocket clients served at once")
       ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
+  app.add_option("--max-connections", options.server.max_connections,
+                 "TCP connections (HTTP and WebSocket) open at once; at the limit the oldest one that only "
+                 "waits (for a request, or a client with no subscription) makes room, else the new one is "
+                 "closed")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  app.add_option("--max-connections-per-address", options.server.max_connections_per_address,
+                 "The same per client IP address")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  app.add_option("--max-subscriptions", options.server.max_subscriptions,
+                 "Subscriptions per client; more are refused with an error status")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  app.add_option("--max-client-buffer", options.server.max_client_buffer,
+                 "Bytes queued for one client; a client over it is closed")
+      ->check(CLI::Range(std::size_t{1024}, std::size_t{1} << 34))
+      ->capture_default_str();
+  app.add_option("--handshake-timeout", options.handshake_timeout_s,
+                 "Seconds a connection has to send a whole HTTP request (a WebSocket upgrade too) and finish "
+                 "the WebSocket handshake")
+      ->check(CLI::Range(0.01, 3600.0))
+      ->capture_default_str();
+  app.add_option("--idle-timeout", options.idle_timeout_s,
+                 "Seconds a WebSocket client may stay without a subscription, or without answering a ping")
+      ->check(CLI::Range(0.01, 86400.0))
+      ->capture_default_str();
+  app.add_option("--stall-timeout", options.stall_timeout_s,
+                 "Seconds a client may take none of its messages before it is closed")
+      ->check(CLI::Range(0.01, 86400.0))
       ->capture_default_str();
   app.add_option("--queue-depth", options.server.queue_depth,
                  "Messages queued per client and subscription; a slower client loses its oldest")
@@ -163,6 +199,12 @@ int run(const Options& options) {
   }
   spdlog::info("received {} states; dropped {} messages for slow clients", summary.samples(),
                server.dropped());
+  const auto limits = server.limit_counts();
+  std::string limit_text;
+  for (std::size_t i = 0; i < limits.size(); ++i)
+    limit_text +=
+        fmt::format("{}{} {}", i == 0 ? "" : ", ", rsg::tools::view::Server::kLimitNames[i], limits[i]);
+  spdlog::info("limits: {}", limit_text);
   const auto counts = server.channel_counts();  // in the order of channels.channels()
   for (std::size_t i = 0; i < counts.size(); ++i) {
     const auto& channel = channels.channels()[i];
@@ -184,6 +226,9 @@ int main(int argc, char** argv) {
   Options options;
   add_options(app, options);
   return run_main(app, argc, argv, [&] {
+    options.server.handshake_timeout = milliseconds_of(options.handshake_timeout_s);
+    options.server.idle_timeout = milliseconds_of(options.idle_timeout_s);
+    options.server.stall_timeout = milliseconds_of(options.stall_timeout_s);
     split_listen(options.listen, options.server);  // the syntax is checked: a name that does not resolve
     rsg::dds::load_profiles(options.profiles, options.participant_profile);
     return run(options);

@@ -1,5 +1,6 @@
 #include "server.hpp"
 
+#include <malloc.h>
 #include <pthread.h>
 #include <spdlog/spdlog.h>
 
@@ -36,9 +37,16 @@ using foxglove::Level;
 
 // A client whose control messages (statuses, errors) pile up this high never reads: it is closed.
 constexpr std::size_t kMaxControlBacklog = 1024;
-constexpr auto kDropReportPeriod = std::chrono::seconds(1);
 constexpr std::size_t kMaxRequestHeader = 8 * 1024;
-constexpr auto kHttpTimeout = std::chrono::seconds(30);
+constexpr auto kTickPeriod = std::chrono::seconds(1);
+// A client without a subscription for this long may make room for a newer connection: a client
+// that just connected has not had the time to subscribe.
+constexpr auto kIdleGrace = std::chrono::seconds(1);
+constexpr auto kLimitLogInterval = std::chrono::minutes(1);
+// A client that queued more than this gives its memory back to the system when it leaves (glibc
+// keeps freed small blocks otherwise, and the process stays that large).
+constexpr std::size_t kTrimAfter = 1 << 20;
+using SteadyClock = std::chrono::steady_clock;
 
 std::string endpoint_text(const tcp::socket& socket) {
   boost::system::error_code ec;
@@ -46,16 +54,28 @@ std::string endpoint_text(const tcp::socket& socket) {
   return ec ? std::string("?") : remote.address().to_string() + ":" + std::to_string(remote.port());
 }
 
+net::ip::address address_of(const tcp::socket& socket) {
+  boost::system::error_code ec;
+  const auto remote = socket.remote_endpoint(ec);
+  return ec ? net::ip::address() : remote.address();
+}
+
 class WsSession;
 
 /// What the I/O thread shares between connections. Touched only from the I/O thread, except the atomics.
 struct Hub {
+  explicit Hub(const ServerOptions& options)
+      : options(options), table({options.max_connections, options.max_connections_per_address}) {}
+
   ServerOptions options;
   std::vector<foxglove::Channel> channels;
   std::string advertise;
   std::map<std::string, WebFile, std::less<>> files;
   std::set<std::shared_ptr<WsSession>> sessions;
   std::uint64_t next_session = 1;
+  app::ConnectionTable table;
+  std::array<std::atomic<std::uint64_t>, Server::kLimitNames.size()> limits{};
+  std::array<SteadyClock::time_point, Server::kLimitNames.size()> limit_logged{};
   std::atomic<std::uint64_t> dropped{0};
   // Per channel, in the order of `channels`; published is written by publish()'s caller.
   std::unique_ptr<std::atomic<std::uint64_t>[]> channel_published, channel_dropped;
@@ -67,20 +87,41 @@ struct Hub {
     return std::nullopt;
   }
   bool has_channel(std::uint32_t id) const { return find(id).has_value(); }
+
+  /// Counts a limit that bit, and says so the first time and then at most once a minute.
+  void count(LimitEvent event, std::string_view what, std::uint64_t n = 1) {
+    const auto i = static_cast<std::size_t>(event);
+    const auto total = limits[i].fetch_add(n, std::memory_order_relaxed) + n;
+    const auto now = SteadyClock::now();
+    if (total != n && now - limit_logged[i] < kLimitLogInterval) return;
+    limit_logged[i] = now;
+    spdlog::warn("limit {}: {} ({} so far)", Server::kLimitNames[i], what, total);
+  }
 };
 
-class WsSession : public std::enable_shared_from_this<WsSession> {
+class WsSession : public std::enable_shared_from_this<WsSession>, public app::ConnectionTable::Member {
  public:
   WsSession(beast::tcp_stream&& stream, Hub& hub, std::string_view subprotocol)
       : ws_(std::move(stream)),
         hub_(hub),
         subprotocol_(subprotocol),
         peer_(endpoint_text(beast::get_lowest_layer(ws_).socket())),
-        timer_(ws_.get_executor()) {}
+        timer_(ws_.get_executor()) {
+    slot_.join(hub_.table, address_of(beast::get_lowest_layer(ws_).socket()), *this);
+  }
+  ~WsSession() {
+    if (buffered_peak_ > kTrimAfter) ::malloc_trim(0);
+  }
+  WsSession(const WsSession&) = delete;
+  WsSession& operator=(const WsSession&) = delete;
 
   void accept(http::request<http::string_body> request) {
     beast::get_lowest_layer(ws_).expires_never();
-    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    websocket::stream_base::timeout timeout{};
+    timeout.handshake_timeout = hub_.options.handshake_timeout;
+    timeout.idle_timeout = hub_.options.idle_timeout;  // a ping at half of it; no answer closes
+    timeout.keep_alive_pings = true;
+    ws_.set_option(timeout);
     ws_.set_option(
         websocket::stream_base::decorator([protocol = subprotocol_](websocket::response_type& response) {
           response.set(http::field::sec_websocket_protocol, protocol);
@@ -91,10 +132,14 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   }
 
   /// A sample for `channel`: queued for each subscription of it, the oldest dropped when full.
+  /// A client over its byte budget is closed (the caller iterates the sessions: finish() follows
+  /// from the read that fails).
   void deliver(std::uint32_t channel, std::uint64_t time_ns, const Payload& payload) {
+    if (closed_) return;
     for (auto& [id, subscription] : subscriptions_) {
       if (subscription.channel != channel) continue;
       if (subscription.queue.size() >= hub_.options.queue_depth) {
+        buffered_ -= queued_size(subscription.queue.front());
         subscription.queue.pop_front();
         ++dropped_;
         ++dropped_by_channel_[channel];
@@ -103,18 +148,31 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
           hub_.channel_dropped[*index].fetch_add(1, std::memory_order_relaxed);
       }
       subscription.queue.push_back({time_ns, payload});
+      buffered_ += queued_size(subscription.queue.back());
     }
+    if (over_budget()) return close();
     pump();
   }
 
   void close() {
     if (closed_) return;
     closed_ = true;
+    slot_.leave();
     timer_.cancel();
+    // Its queues go now: a closed client holds no payloads until its last operation returns.
+    subscriptions_.clear();
+    control_.clear();
+    buffered_ = 0;
     beast::error_code ignored;
     beast::get_lowest_layer(ws_).socket().shutdown(tcp::socket::shutdown_both, ignored);
     beast::get_lowest_layer(ws_).close();
   }
+
+  void evict() override { finish(); }
+
+  /// Without a subscription since at least kIdleGrace: may make room for another client.
+  bool idle() const { return idle_; }
+  std::uint64_t number() const { return number_; }
 
  private:
   struct Queued {
@@ -126,20 +184,48 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     std::deque<Queued> queue;
   };
 
+  static std::size_t queued_size(const Queued& queued) {
+    return queued.payload->size() + foxglove::kMessageHeaderSize;
+  }
+
+  bool over_budget() {
+    buffered_peak_ = std::max(buffered_peak_, buffered_);
+    if (buffered_ <= hub_.options.max_client_buffer) return false;
+    hub_.count(LimitEvent::kBuffer, "client " + peer_ + " has over " +
+                                        std::to_string(hub_.options.max_client_buffer) +
+                                        " bytes queued: closed");
+    return true;
+  }
+
   void on_accept(beast::error_code ec) {
-    if (ec) return;  // never counted as a client
+    if (ec) {  // never counted as a client
+      if (ec == beast::error::timeout)
+        hub_.count(LimitEvent::kHandshake, "client " + peer_ + " did not finish its WebSocket handshake");
+      return close();
+    }
     if (hub_.sessions.size() >= hub_.options.max_clients) {
-      spdlog::warn("refusing {}: already {} clients", peer_, hub_.sessions.size());
-      ws_.async_close(websocket::close_reason(websocket::close_code::try_again_later, "too many clients"),
-                      [self = shared_from_this()](beast::error_code) {});
-      return;
+      // The client idle the longest makes room; with none idle this one is refused.
+      std::shared_ptr<WsSession> victim;
+      for (const auto& session : hub_.sessions)
+        if (session->idle() && (!victim || session->number() < victim->number())) victim = session;
+      hub_.count(LimitEvent::kClients, "already " + std::to_string(hub_.sessions.size()) + " clients: " +
+                                           (victim ? "closed the longest idle one" : "refused " + peer_));
+      if (!victim) {
+        slot_.leave();
+        ws_.async_close(websocket::close_reason(websocket::close_code::try_again_later, "too many clients"),
+                        [self = shared_from_this()](beast::error_code) {});
+        return;
+      }
+      victim->finish();
     }
     hub_.sessions.insert(shared_from_this());
+    number_ = hub_.next_session++;
+    last_activity_ = SteadyClock::now();
     spdlog::info("client {} connected ({})", peer_, subprotocol_);
-    send_text(foxglove::server_info("rsg_view", std::to_string(hub_.next_session++)));
+    send_text(foxglove::server_info("rsg_view", std::to_string(number_)));
     send_text(hub_.advertise);
     read();
-    schedule_drop_report();
+    schedule_tick();
   }
 
   void read() {
@@ -152,9 +238,12 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       if (ec == websocket::error::message_too_big)
         spdlog::warn("client {} sent a message over {} bytes: closed", peer_,
                      hub_.options.max_client_message);
+      if (ec == beast::error::timeout)
+        hub_.count(LimitEvent::kIdle, "client " + peer_ + " answered no ping: closed");
       return finish();
     }
-    const auto now = std::chrono::steady_clock::now();
+    const auto now = SteadyClock::now();
+    last_activity_ = now;
     if (now - window_start_ >= std::chrono::seconds(1)) {
       window_start_ = now;
       window_count_ = 0;
@@ -177,19 +266,41 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
         [this](auto&& message) {
           using T = std::decay_t<decltype(message)>;
           if constexpr (std::is_same_v<T, foxglove::Subscribe>) {
+            // One status for the whole message however many it refuses: a message of thousands of
+            // bad subscriptions must not become thousands of statuses.
+            std::string first_error;
+            std::size_t errors = 0, over_limit = 0;
             for (const auto& subscription : message.subscriptions) {
+              std::string error;
               if (!hub_.has_channel(subscription.channel_id)) {
-                send_text(
-                    foxglove::status(Level::error, "no channel " + std::to_string(subscription.channel_id)));
+                error = "no channel " + std::to_string(subscription.channel_id);
               } else if (subscriptions_.contains(subscription.id)) {
-                send_text(foxglove::status(
-                    Level::error, "subscription id " + std::to_string(subscription.id) + " is in use"));
+                error = "subscription id " + std::to_string(subscription.id) + " is in use";
+              } else if (subscriptions_.size() >= hub_.options.max_subscriptions) {
+                error =
+                    "at most " + std::to_string(hub_.options.max_subscriptions) + " subscriptions per client";
+                ++over_limit;
               } else {
                 subscriptions_[subscription.id] = Subscription{subscription.channel_id, {}};
               }
+              if (!error.empty() && errors++ == 0) first_error = std::move(error);
             }
+            if (errors > 0)
+              send_text(foxglove::status(
+                  Level::error,
+                  first_error +
+                      (errors > 1 ? " (and " + std::to_string(errors - 1) + " more refused)" : "")));
+            if (over_limit > 0)
+              hub_.count(LimitEvent::kSubscriptions,
+                         "client " + peer_ + ": " + std::to_string(over_limit) + " subscription(s) refused",
+                         over_limit);
           } else if constexpr (std::is_same_v<T, foxglove::Unsubscribe>) {
-            for (const auto id : message.subscription_ids) subscriptions_.erase(id);
+            for (const auto id : message.subscription_ids) {
+              const auto it = subscriptions_.find(id);
+              if (it == subscriptions_.end()) continue;
+              for (const auto& queued : it->second.queue) buffered_ -= queued_size(queued);
+              subscriptions_.erase(it);
+            }
           } else if constexpr (std::is_same_v<T, foxglove::Unsupported>) {
             send_text(foxglove::status(Level::error, "unsupported operation '" + message.op + "'"));
           } else {
@@ -201,11 +312,14 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   }
 
   void send_text(std::string text) {
+    if (closed_) return;
     if (control_.size() >= kMaxControlBacklog) {
       spdlog::warn("client {} reads none of its status messages: closed", peer_);
       return finish();
     }
+    buffered_ += text.size();
     control_.push_back(std::move(text));
+    if (over_budget()) return finish();
     pump();
   }
 
@@ -215,7 +329,9 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     if (!control_.empty()) {
       text_out_ = std::move(control_.front());
       control_.pop_front();
+      buffered_ -= text_out_.size();
       writing_ = true;
+      write_started_ = SteadyClock::now();
       ws_.text(true);
       ws_.async_write(net::buffer(text_out_),
                       [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_write(ec); });
@@ -229,6 +345,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       last_served_ = it->first;
       Queued next = std::move(it->second.queue.front());
       it->second.queue.pop_front();
+      buffered_ -= queued_size(next);
+      write_started_ = SteadyClock::now();
       header_out_ = foxglove::message_header(it->first, next.time_ns);
       payload_out_ = std::move(next.payload);
       const std::array<net::const_buffer, 2> buffers{net::buffer(header_out_), net::buffer(*payload_out_)};
@@ -247,10 +365,24 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     pump();
   }
 
-  void schedule_drop_report() {
-    timer_.expires_after(kDropReportPeriod);
+  /// Once a second: the drop report, and the idle and stall limits.
+  void schedule_tick() {
+    timer_.expires_after(kTickPeriod);
     timer_.async_wait([self = shared_from_this()](beast::error_code ec) {
       if (ec || self->closed_) return;
+      const auto now = SteadyClock::now();
+      const auto quiet = now - self->last_activity_;
+      self->idle_ = self->subscriptions_.empty() && quiet >= kIdleGrace;
+      self->slot_.waiting(self->idle_);
+      if (self->idle_ && quiet >= self->hub_.options.idle_timeout) {
+        self->hub_.count(LimitEvent::kIdle, "client " + self->peer_ + " subscribed to nothing: closed");
+        return self->finish();
+      }
+      if (self->writing_ && now - self->write_started_ >= self->hub_.options.stall_timeout) {
+        self->hub_.count(LimitEvent::kStalled,
+                         "client " + self->peer_ + " takes none of its messages: closed");
+        return self->finish();
+      }
       if (self->dropped_ != self->reported_) {
         self->reported_ = self->dropped_;
         const std::string text = "dropped " + std::to_string(self->dropped_) +
@@ -259,7 +391,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
         spdlog::warn("client {}: {}", self->peer_, text);
         self->send_text(foxglove::status(Level::warning, text, "rsg_view.dropped"));
       }
-      self->schedule_drop_report();
+      self->schedule_tick();
     });
   }
 
@@ -286,6 +418,11 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   std::string subprotocol_;
   std::string peer_;
   net::steady_timer timer_;
+  app::ConnectionTable::Slot slot_;
+  std::uint64_t number_ = 0;
+  SteadyClock::time_point last_activity_ = SteadyClock::now(), write_started_{};
+  bool idle_ = false;
+  std::size_t buffered_ = 0, buffered_peak_ = 0;  // bytes queued: payloads, their headers, statuses
   beast::flat_buffer in_;
   std::deque<std::string> control_;
   std::map<std::uint32_t, Subscription> subscriptions_;
@@ -297,27 +434,43 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   bool closed_ = false;
   std::uint64_t dropped_ = 0, reported_ = 0;
   std::map<std::uint32_t, std::uint64_t> dropped_by_channel_;  // channel id -> messages
-  std::chrono::steady_clock::time_point window_start_{};
+  SteadyClock::time_point window_start_{};
   std::size_t window_count_ = 0;
 };
 
 /// One HTTP connection: serves files until it asks for a WebSocket, then hands its socket over.
-class HttpSession : public std::enable_shared_from_this<HttpSession> {
+class HttpSession : public std::enable_shared_from_this<HttpSession>, public app::ConnectionTable::Member {
  public:
-  HttpSession(tcp::socket&& socket, Hub& hub) : stream_(std::move(socket)), hub_(hub) {}
+  HttpSession(tcp::socket&& socket, Hub& hub, const net::ip::address& address)
+      : stream_(std::move(socket)), hub_(hub) {
+    slot_.join(hub_.table, address, *this);
+  }
+  HttpSession(const HttpSession&) = delete;
+  HttpSession& operator=(const HttpSession&) = delete;
 
   void read() {
     parser_.emplace();
     parser_->header_limit(kMaxRequestHeader);
     parser_->body_limit(hub_.options.max_client_message);
-    stream_.expires_after(kHttpTimeout);
+    stream_.expires_after(hub_.options.handshake_timeout);
+    slot_.waiting(true);
     http::async_read(stream_, buffer_, *parser_,
                      [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
   }
 
+  void evict() override {
+    beast::error_code ignored;
+    stream_.socket().shutdown(tcp::socket::shutdown_both, ignored);
+    stream_.socket().close(ignored);
+  }
+
  private:
   void on_read(beast::error_code ec) {
+    slot_.waiting(false);
     if (ec) {
+      if (ec == beast::error::timeout)
+        hub_.count(LimitEvent::kHandshake, "a connection sent no whole request in time: closed");
+      slot_.leave();
       beast::error_code ignored;
       stream_.socket().shutdown(tcp::socket::shutdown_both, ignored);
       return;
@@ -331,6 +484,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
                        "rsg_view speaks the Foxglove WebSocket protocol: offer the subprotocol " +
                            std::string(foxglove::kSdkSubprotocol) + " or " +
                            std::string(foxglove::kLegacySubprotocol) + "\n");
+      slot_.leave();  // the WebSocket session takes the connection's place
       std::make_shared<WsSession>(std::move(stream_), hub_, subprotocol)->accept(std::move(request));
       return;
     }
@@ -354,6 +508,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 
   beast::tcp_stream stream_;
   Hub& hub_;
+  app::ConnectionTable::Slot slot_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
 };
@@ -361,24 +516,43 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 }  // namespace
 
 struct Server::Impl {
+  explicit Impl(const ServerOptions& options) : hub(options) {}
+
+  Hub hub;  // first: the sessions the context destroys last still leave its table
   net::io_context io{1};
-  Hub hub;
   tcp::acceptor acceptor{io};
+  app::AcceptLoop accepting{acceptor, "rsg_view",
+                            [this](tcp::socket socket) { on_connection(std::move(socket)); },
+                            [this] {
+                              hub.count(LimitEvent::kAcceptFailures, "accept failed: backing off");
+                              hub.table.evict_oldest_waiting();
+                            }};
   std::thread thread;
 
-  void accept() {
-    acceptor.async_accept([this](beast::error_code ec, tcp::socket socket) {
-      if (ec == net::error::operation_aborted) return;
-      if (!ec) std::make_shared<HttpSession>(std::move(socket), hub)->read();
-      accept();
-    });
+  void on_connection(tcp::socket socket) {
+    beast::error_code ec;
+    const auto remote = socket.remote_endpoint(ec);
+    if (ec) return;  // gone already
+    const auto admission = hub.table.make_room(remote.address());
+    if (admission.limit) {
+      const bool per_address = *admission.limit == app::ConnectionLimit::kPerAddress;
+      hub.count(per_address ? LimitEvent::kPerAddress : LimitEvent::kConnections,
+                std::string(admission.admitted ? "closed an older waiting connection for "
+                                               : "refused a connection from ") +
+                    remote.address().to_string() +
+                    (per_address ? " (per address)" : " (" + std::to_string(hub.table.size()) + " open)"));
+    }
+    if (!admission.admitted) {
+      socket.close(ec);
+      return;
+    }
+    std::make_shared<HttpSession>(std::move(socket), hub, remote.address())->read();
   }
 };
 
 Server::Server(const ServerOptions& options, std::vector<foxglove::Channel> channels,
                std::vector<WebFile> files)
-    : impl_(std::make_unique<Impl>()) {
-  impl_->hub.options = options;
+    : impl_(std::make_unique<Impl>(options)) {
   impl_->hub.advertise = foxglove::advertise(channels);
   impl_->hub.channels = std::move(channels);
   const std::size_t count = impl_->hub.channels.size();
@@ -394,7 +568,7 @@ Server::Server(const ServerOptions& options, std::vector<foxglove::Channel> chan
   if (const auto listen_error = rsg::app::listen_on(impl_->acceptor, tcp::endpoint(address, options.port)))
     throw EnvironmentError("cannot listen on " + options.host + ":" + std::to_string(options.port) + ": " +
                            listen_error.message());
-  impl_->accept();
+  impl_->accepting.start();
   impl_->thread = std::thread([impl = impl_.get()] {
     ::pthread_setname_np(::pthread_self(), "rsg-view-http");  // CONTRIBUTING.md, Threads
     impl->io.run();
@@ -405,8 +579,7 @@ Server::~Server() {
   // Closed on the I/O thread, which owns the sessions; stopping the loop before this ran would leak them.
   std::promise<void> closed;
   net::post(impl_->io, [impl = impl_.get(), &closed] {
-    beast::error_code ignored;
-    impl->acceptor.close(ignored);
+    impl->accepting.stop();
     for (const auto& session : std::set(impl->hub.sessions)) session->close();
     impl->hub.sessions.clear();
     closed.set_value();
@@ -427,6 +600,13 @@ void Server::publish(std::uint32_t channel, std::uint64_t time_ns, Payload paylo
 std::uint16_t Server::port() const { return impl_->acceptor.local_endpoint().port(); }
 
 std::uint64_t Server::dropped() const { return impl_->hub.dropped.load(std::memory_order_relaxed); }
+
+std::array<std::uint64_t, Server::kLimitNames.size()> Server::limit_counts() const {
+  std::array<std::uint64_t, kLimitNames.size()> counts{};
+  for (std::size_t i = 0; i < counts.size(); ++i)
+    counts[i] = impl_->hub.limits[i].load(std::memory_order_relaxed);
+  return counts;
+}
 
 std::vector<ChannelCount> Server::channel_counts() const {
   const Hub& hub = impl_->hub;

@@ -8,11 +8,23 @@
 // Subscriptions are served round-robin, one message each in turn, so a small channel (status,
 // transform) gets at least the share of a big one and, arriving slower than that share, loses
 // nothing however far behind the client is on the big one (view.fair_share tests it).
+//
+// What an outsider can make it hold is bounded (docs/security.md; view.attack_* test it):
+// connections in total and per address (app::ConnectionTable: at a limit the oldest connection
+// that only waits makes room, an HTTP one waiting for its request or a WebSocket client with no
+// subscription), WebSocket clients, subscriptions per client, bytes queued per client (a client
+// over it is closed, not slowed for everyone), the time to send a request or handshake, the time a
+// client may sit without a subscription, the time a write to it may stay pending; at the fd limit
+// the accept loop backs off and closes the oldest waiting connection. Each limit that bites is
+// counted (limit_counts(), logged at exit) and logged at most once a minute.
 #pragma once
 
+#include <array>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "foxglove_protocol.hpp"
@@ -21,11 +33,35 @@ namespace rsg::tools::view {
 
 struct ServerOptions {
   std::string host = "127.0.0.1";
-  std::uint16_t port = 8765;  ///< 0: any free port (see Server::port())
-  std::size_t max_clients = 16;
+  std::uint16_t port = 8765;                    ///< 0: any free port (see Server::port())
+  std::size_t max_clients = 16;                 ///< WebSocket clients
+  std::size_t max_connections = 64;             ///< TCP connections, HTTP and WebSocket
+  std::size_t max_connections_per_address = 8;  ///< the same per client IP address
+  std::size_t max_subscriptions = 16;  ///< per client (Foxglove takes one per channel); more are refused
+  std::size_t max_client_buffer = 32 << 20;     ///< bytes queued for one client; over it it is closed
   std::size_t queue_depth = 256;                ///< messages per subscription and client
   std::size_t max_client_message = 64 * 1024;   ///< bytes of one client text frame
   std::size_t max_client_messages_per_s = 100;  ///< more are answered with an error and ignored
+  /// An HTTP request (a WebSocket upgrade too) and the WebSocket handshake must arrive within this.
+  std::chrono::milliseconds handshake_timeout = std::chrono::seconds(10);
+  /// A WebSocket client without a subscription, or answering no ping, is closed after this.
+  std::chrono::milliseconds idle_timeout = std::chrono::seconds(60);
+  /// A client that takes none of its messages for this long is closed.
+  std::chrono::milliseconds stall_timeout = std::chrono::seconds(20);
+};
+
+/// What a limit did, counted since start: the order of Server::kLimitNames.
+enum class LimitEvent : std::size_t {
+  kPerAddress,      ///< a connection met max_connections_per_address
+  kConnections,     ///< a connection met max_connections
+  kClients,         ///< a WebSocket client met max_clients
+  kHandshake,       ///< a request or handshake did not arrive within handshake_timeout
+  kIdle,            ///< a client without a subscription (or not answering pings) for idle_timeout
+  kStalled,         ///< a client that took nothing for stall_timeout
+  kBuffer,          ///< a client over max_client_buffer
+  kSubscriptions,   ///< subscriptions refused over max_subscriptions
+  kAcceptFailures,  ///< accept failed (EMFILE, ...): backed off
+  kCount
 };
 
 /// A file the HTTP side serves.
@@ -62,6 +98,12 @@ class Server {
   std::uint64_t dropped() const;
   /// The same per channel, in the order of the channels given to the constructor.
   std::vector<ChannelCount> channel_counts() const;
+
+  static constexpr std::array<std::string_view, static_cast<std::size_t>(LimitEvent::kCount)> kLimitNames = {
+      "per_address", "connections", "clients",       "handshake_timeout", "idle_timeout",
+      "stalled",     "buffer",      "subscriptions", "accept_failures"};
+  /// How often each limit bit since start, in the order of kLimitNames.
+  std::array<std::uint64_t, kLimitNames.size()> limit_counts() const;
 
  private:
   struct Impl;

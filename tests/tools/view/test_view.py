@@ -6,6 +6,7 @@ client and Foxglove's CDR decoder (check_view.mjs), or Debian's headless Chromiu
 """
 
 import json
+import os
 import re
 import shutil
 import socket
@@ -247,6 +248,139 @@ def limits(h):
     check("sent a message over 65536 bytes: closed" in err and "already 1 clients" in err, f"rsg_view's log: {err}")
     check(h.stop("view", view) == 0, "rsg_view did not exit 0 on SIGTERM")
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+ATTACK = str(HERE / "attack_client.mjs")
+
+
+def rss_kb(pid):
+    with open(f"/proc/{pid}/status") as status:
+        return next(int(line.split()[1]) for line in status if line.startswith("VmRSS:"))
+
+
+def cpu_s(pid):
+    """User and system CPU seconds of a process so far."""
+    with open(f"/proc/{pid}/stat") as stat:
+        fields = stat.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def open_fds(pid):
+    return len(os.listdir(f"/proc/{pid}/fd"))
+
+
+def limit_counts(h, label="view"):
+    """rsg_view's `limits:` line at exit, as {name: count}."""
+    match = re.search(r"limits: (.*)", (h.dir / f"{label}.err").read_text())
+    check(match is not None, f"{label} logged no limits line at exit")
+    return {name: int(value) for name, value in (item.split() for item in match.group(1).split(", "))}
+
+
+def legit_client(h, label, ws_port, count, timeout_ms):
+    """A Foxglove client that subscribes to RobotState and must get `count` messages in time."""
+    status = h.run(label, [node(), ATTACK, "legit", f"ws://127.0.0.1:{ws_port}/", str(count), str(timeout_ms)],
+                   timeout_s=timeout_ms / 1000 + 15)
+    check(status == 0, f"the legitimate client got no data: {(h.dir / f'{label}.err').read_text()}")
+    result = json.loads(h.output(label).read_text().splitlines()[-1])
+    print(f"[{h.name}] {label}: {count} messages in {result['ms']} ms", flush=True)
+
+
+def attack_subscriptions(h):
+    """One client sends 40 subscribe requests of 1,024 subscriptions each while rsg_sim streams at
+    1 kHz: rsg_view keeps --max-subscriptions (16) of them, answers each request with one error
+    status, counts the 40,944 it refused and logs the limit once; a legitimate client subscribed
+    meanwhile gets its messages; and once the attacker left, rsg_view's memory is back within 8 MB
+    of what it was."""
+    port, gateway, stats, view, ws_port = start_view(h)
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "60000"])
+    legit_client(h, "warmup", ws_port, 500, 15000)  # the baseline holds a client's allocations too
+    rss_before, cpu_before, start = rss_kb(view.pid), cpu_s(view.pid), time.monotonic()
+    attacker = h.start("attacker", [node(), ATTACK, "subscribe", f"ws://127.0.0.1:{ws_port}/", "40", "1024", "5000"])
+    time.sleep(1.0)
+    rss_during = rss_kb(view.pid)
+    legit_client(h, "legit", ws_port, 1000, 10000)
+    check(h.wait("attacker", attacker, 30) == 0, f"the attacker failed: {(h.dir / 'attacker.err').read_text()}")
+    cpu = (cpu_s(view.pid) - cpu_before) / (time.monotonic() - start)
+    result = json.loads(h.output("attacker").read_text().splitlines()[-1])
+    time.sleep(2.0)
+    rss_after = rss_kb(view.pid)
+    print(f"[{h.name}] attacker: {result}; rsg_view CPU {cpu:.0%} of a core during the attack; "
+          f"RSS {rss_before} kB before, {rss_during} kB during, {rss_after} kB after", flush=True)
+    check(h.stop("sim", sim) == 0, "rsg_sim did not exit 0 on SIGTERM")
+    check(h.stop("view", view) == 0, "rsg_view did not exit 0 on SIGTERM")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+    check(result["errors"] == 40, f"one error status per refused request expected: {result}")
+    counts = limit_counts(h)
+    check(counts["subscriptions"] == 40 * 1024 - 16, f"subscriptions refused: {counts}")
+    check((h.dir / "view.err").read_text().count("limit subscriptions:") == 1, "the limit was not logged once")
+    check(rss_after - rss_before < 8 * 1024, f"rsg_view's memory did not come back: {rss_before} -> {rss_after} kB")
+
+
+def attack_idle_clients(h):
+    """16 WebSocket clients from 16 addresses connect and subscribe to nothing (answering pings):
+    they take every place of --max-clients 16, yet a legitimate client arriving after them gets its
+    data (the longest idle one makes room: counted as `clients`), and with --idle-timeout 4 every
+    idle one is closed 4 s after it connected (counted as `idle_timeout`)."""
+    port, gateway, stats, view, ws_port = start_view(h, "--idle-timeout", "4")
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "60000"])
+    idle = h.start("idle", [node(), ATTACK, "idle", f"ws://127.0.0.1:{ws_port}/", "16", "127.0.0.30", "9000"])
+    time.sleep(2.5)  # connected, and idle for longer than the grace a new client gets
+    legit_client(h, "legit", ws_port, 200, 5000)
+    check(h.wait("idle", idle, 30) == 0, f"the idle clients failed: {(h.dir / 'idle.err').read_text()}")
+    result = json.loads(h.output("idle").read_text().splitlines()[-1])
+    print(f"[{h.name}] idle clients: {result}", flush=True)
+    check(h.stop("sim", sim) == 0, "rsg_sim did not exit 0 on SIGTERM")
+    check(h.stop("view", view) == 0, "rsg_view did not exit 0 on SIGTERM")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+    check(result["opened"] == 16 and result["closed_by_server"] == 16, f"idle clients: {result}")
+    counts = limit_counts(h)
+    check(counts["clients"] >= 1 and counts["idle_timeout"] >= 15, f"limits: {counts}")
+
+
+def attack_tcp(h):
+    """1,100 TCP connections that never send a byte, from 10 addresses, each renewed as soon as
+    rsg_view closes it, for 8 s: rsg_view never holds more than --max-connections (64) of them, a
+    legitimate client gets its data meanwhile, and the limits are counted. Then a second rsg_view,
+    whose --max-connections is past its fd limit (prlimit --nofile 64): accept fails with EMFILE and
+    it backs off instead of spinning (under a third of a core), counted as `accept_failures`."""
+    port, gateway, stats, view, ws_port = start_view(h)
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "60000"])
+    fds_before, cpu_before, start = open_fds(view.pid), cpu_s(view.pid), time.monotonic()
+    attacker = h.start("attacker", [node(), ATTACK, "tcp", "127.0.0.1", str(ws_port), "1100", "10", "8000"])
+    time.sleep(2.0)
+    fds_during = 0
+    for _ in range(20):
+        fds_during = max(fds_during, open_fds(view.pid))
+        time.sleep(0.05)
+    legit_client(h, "legit", ws_port, 200, 5000)
+    check(h.wait("attacker", attacker, 30) == 0, f"the attacker failed: {(h.dir / 'attacker.err').read_text()}")
+    cpu = (cpu_s(view.pid) - cpu_before) / (time.monotonic() - start)
+    result = json.loads(h.output("attacker").read_text().splitlines()[-1])
+    print(f"[{h.name}] attacker: {result}; rsg_view fds {fds_before} before, {fds_during} at most during; "
+          f"CPU {cpu:.0%} of a core", flush=True)
+    check(fds_during <= fds_before + 64 + 2, f"rsg_view held {fds_during - fds_before} connections")
+
+    # The fd limit itself: rsg_view with its own cap set past it.
+    other_port = free_tcp_port()
+    other = h.start("view_fds", ["prlimit", "--nofile=64:64", h.binary("rsg_view"), "--domain", str(h.domain),
+                                 "--listen", f"127.0.0.1:{other_port}", "--max-connections", "1000",
+                                 "--max-connections-per-address", "1000"])
+    wait_for(lambda: "serving" in (h.dir / "view_fds.err").read_text(), "the second rsg_view to listen")
+    flood = h.start("flood", [node(), ATTACK, "tcp", "127.0.0.1", str(other_port), "300", "20", "5000"])
+    time.sleep(1.5)
+    cpu_before, start = cpu_s(other.pid), time.monotonic()
+    time.sleep(3.0)
+    other_cpu = (cpu_s(other.pid) - cpu_before) / (time.monotonic() - start)
+    check(h.wait("flood", flood, 30) == 0, f"the flood failed: {(h.dir / 'flood.err').read_text()}")
+    print(f"[{h.name}] at the fd limit: rsg_view CPU {other_cpu:.0%} of a core", flush=True)
+    check(h.stop("view_fds", other) == 0, "the second rsg_view did not exit 0 on SIGTERM")
+    check(h.stop("sim", sim) == 0, "rsg_sim did not exit 0 on SIGTERM")
+    check(h.stop("view", view) == 0, "rsg_view did not exit 0 on SIGTERM")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+    counts = limit_counts(h)
+    check(counts["connections"] > 0 and counts["per_address"] > 0, f"limits: {counts}")
+    check(other_cpu < 0.34, f"rsg_view spins at the fd limit: {other_cpu:.0%} of a core")
+    check(limit_counts(h, "view_fds")["accept_failures"] > 0, "accept never failed: was the fd limit reached?")
 
 
 def page(h):
