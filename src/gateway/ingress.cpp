@@ -70,7 +70,7 @@ Ingress::Ingress(dds::Participant& participant, Options options)
       socket_(transport::UdpSocket::bind(options_.listen)),
       participant_(participant),
       batch_(kBatchDatagrams, wire::kMaxFrameBytes),
-      sequence_(options_.restart_threshold_ms),
+      sequence_(options_.restart_threshold_ms, LinkMonitor(options_.nominal_period).silence_limit()),
       link_(options_.nominal_period) {
   // The link monitor and the delay counters judge by when frames arrived, not by when a busy
   // ingress got round to them.
@@ -165,29 +165,54 @@ void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::
   const wire::FrameView& frame = decoded.frame();
 
   const std::optional<std::uint64_t> robot_time_ms = frame_time(frame, slot.sample());
-  sequence_.observe(frame.packet_number(), robot_time_ms);
+  // A frame that does not continue the stream (late, replayed, forged: sequence_tracker.hpp) is
+  // counted there and goes no further: no consumer, rate topic or link state sees it. The one that
+  // may start a restarted sequence is kept, to go out first should the next frame confirm it.
+  switch (sequence_.observe(frame.packet_number(), robot_time_ms, arrival)) {
+    case SequenceTracker::Verdict::kOutOfSequence:
+      return;
+    case SequenceTracker::Verdict::kHeld:
+      held_sample_ = slot.sample();  // a plain copy into storage allocated at start-up
+      held_selection_ = frame.selection();
+      held_time_ms_ = robot_time_ms;
+      return;
+    case SequenceTracker::Verdict::kInSequence:
+      break;
+  }
   link_came_up_ |= link_.on_frame(arrival);
   source_ = datagram.from;
   if (requester_ && requester_->due(frame.selection(), now))
     request_selection(options_.robot ? *options_.robot : datagram.from, now);
 
-  if (options_.on_sample) options_.on_sample(slot.sample());
-  // Before the full-rate write, which hands a loaned sample over to the middleware. The slower
-  // outputs are paced by the robot's time when the frame carries it, else by arrival.
-  if (!rate_writers_.empty() || standard_topics_) {
-    const std::chrono::nanoseconds t =
-        robot_time_ms ? std::chrono::nanoseconds(std::chrono::milliseconds(*robot_time_ms))
-                      : std::chrono::nanoseconds(now.time_since_epoch());
-    if (!rate_writers_.empty()) write_rate_topics(slot.sample(), t);
-    if (standard_topics_) standard_topics_->offer(slot.sample(), frame.selection(), t);
+  if (sequence_.releases_held()) {
+    deliver(held_sample_, held_selection_, held_time_ms_, now);
+    count_write(dds::succeeded(writer_->write(&held_sample_)));  // a copy into the writer's history
   }
-  if (slot.write())
-    ++counters_.published;
-  else
-    ++counters_.publish_failed;
+  deliver(slot.sample(), frame.selection(), robot_time_ms, now);
+  count_write(slot.write());
   const auto delay = Clock::now() - arrival;
   delay_period_max_ = std::max(delay_period_max_, delay);
   delay_max_ = std::max(delay_max_, delay);
+}
+
+void Ingress::deliver(const RobotState& sample, const wire::Selection& selection,
+                      std::optional<std::uint64_t> robot_time_ms, Clock::time_point now) {
+  if (options_.on_sample) options_.on_sample(sample);
+  // Before the full-rate write, which hands a loaned sample over to the middleware. The slower
+  // outputs are paced by the robot's time when the frame carries it, else by arrival.
+  if (rate_writers_.empty() && !standard_topics_) return;
+  const std::chrono::nanoseconds t = robot_time_ms
+                                         ? std::chrono::nanoseconds(std::chrono::milliseconds(*robot_time_ms))
+                                         : std::chrono::nanoseconds(now.time_since_epoch());
+  if (!rate_writers_.empty()) write_rate_topics(sample, t);
+  if (standard_topics_) standard_topics_->offer(sample, selection, t);
+}
+
+void Ingress::count_write(bool written) {
+  if (written)
+    ++counters_.published;
+  else
+    ++counters_.publish_failed;
 }
 
 void Ingress::write_rate_topics(const RobotState& sample, std::chrono::nanoseconds t) {
