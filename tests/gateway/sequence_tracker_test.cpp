@@ -86,16 +86,17 @@ TEST(SequenceTracker, RepeatedFrameIsADuplicate) {
 }
 
 TEST(SequenceTracker, DuplicateOfAnOlderFrameIsStillADuplicate) {
-  EXPECT_EQ(track({{0}, {1}, {2}, {3}, {1}}), (Counts{.duplicated = 1}));
+  // Its time is older than the newest frame's: counted, not published.
+  EXPECT_EQ(track({{0}, {1}, {2}, {3}, {1}}), (Counts{.duplicated = 1, .out_of_sequence = 1}));
 }
 
 TEST(SequenceTracker, SwappedFramesAreOneReorderAndNoLoss) {
-  EXPECT_EQ(track({{0}, {2}, {1}, {3}}), (Counts{.reordered = 1}));
+  EXPECT_EQ(track({{0}, {2}, {1}, {3}}), (Counts{.reordered = 1, .out_of_sequence = 1}));
   EXPECT_EQ(track({{0, false}, {2, false}, {1, false}, {3, false}}), (Counts{.reordered = 1}));
 }
 
 TEST(SequenceTracker, LateFrameArrivingTwiceIsReorderedThenDuplicated) {
-  EXPECT_EQ(track({{0}, {2}, {1}, {1}}), (Counts{.duplicated = 1, .reordered = 1}));
+  EXPECT_EQ(track({{0}, {2}, {1}, {1}}), (Counts{.duplicated = 1, .reordered = 1, .out_of_sequence = 2}));
 }
 
 TEST(SequenceTracker, WithoutTimeABurstLossIsCountedModuloSixteen) {
@@ -124,7 +125,7 @@ TEST(SequenceTracker, WithTimeLateFramesUpToSixteenBehindAreReordered) {
     for (std::uint64_t i = 1; i <= 16; ++i)
       if (i != late) arrivals.push_back({i});
     arrivals.push_back({late});
-    EXPECT_EQ(track(arrivals), (Counts{.reordered = 1})) << "late " << late;
+    EXPECT_EQ(track(arrivals), (Counts{.reordered = 1, .out_of_sequence = 1})) << "late " << late;
   }
 }
 
@@ -171,6 +172,26 @@ TEST(SequenceTracker, ARestartWithoutAPauseIsBelievedOnceTheOldStreamIsSilent) {
   EXPECT_EQ(tracker.counts(), (Counts{.restarts = 1, .out_of_sequence = 8}));
 }
 
+// Frames lost while the new sequence waits for the old one's silence are lost in the new sequence.
+TEST(SequenceTracker, LossesWhileARestartIsConfirmedCountInTheNewSequence) {
+  Tracker tracker(100);
+  for (std::uint8_t i = 0; i < 40; ++i) tracker.observe(i % 16, 10'000 + i);
+  for (std::uint8_t i = 0; i < 40; ++i)
+    if (i != 3) tracker.observe(i % 16, i);
+  EXPECT_EQ(tracker.counts(), (Counts{.lost = 1, .restarts = 1, .out_of_sequence = 8}));
+}
+
+// A robot restarted soon after its start: its new times are below the old ones by less than the
+// threshold, yet after the old stream's silence they start a new sequence, not late frames.
+TEST(SequenceTracker, ARobotRestartedSoonAfterItsStartIsARestart) {
+  Tracker tracker(100);
+  for (std::uint64_t i = 0; i < 50; ++i) tracker.observe_at(i, static_cast<std::uint8_t>(i % 16), i);
+  EXPECT_EQ(tracker.observe_at(200, 0, 0), Verdict::kHeld);
+  EXPECT_EQ(tracker.observe_at(201, 1, 1), Verdict::kInSequence);
+  EXPECT_TRUE(tracker.releases_held());
+  EXPECT_EQ(tracker.counts(), (Counts{.restarts = 1}));
+}
+
 TEST(SequenceTracker, TimeGoingBackWithinTheThresholdIsReorderingAndNotPublished) {
   Tracker tracker(100);
   EXPECT_EQ(tracker.observe(0, 1000), Verdict::kInSequence);
@@ -206,14 +227,16 @@ TEST(SequenceTracker, ReplayedFramesInterleavedWithTheStreamAreOnlyOutOfSequence
 TEST(SequenceTracker, ForgedFramesInterleavedWithTheStreamAreOnlyOutOfSequence) {
   Tracker tracker(100);
   std::mt19937_64 random(39);
-  for (std::uint64_t i = 0; i < 200; ++i) tracker.observe(static_cast<std::uint8_t>(i % 16), 5000 + i);
+  // The robot's frame i arrives at i ms, a forged one right before it.
+  for (std::uint64_t i = 0; i < 200; ++i) tracker.observe_at(i, static_cast<std::uint8_t>(i % 16), 5000 + i);
   for (std::uint64_t i = 200; i < 1200; ++i) {
     const std::uint64_t newest = 5000 + i - 1;
     const std::uint64_t forged_time =
         random() % 2 ? random() % (newest - 100) : newest + 1000 + random() % 1'000'000;
-    EXPECT_EQ(tracker.observe(static_cast<std::uint8_t>(random() % 16), forged_time), Verdict::kHeld)
+    EXPECT_EQ(tracker.observe_at(i - 1, static_cast<std::uint8_t>(random() % 16), forged_time),
+              Verdict::kHeld)
         << "forged time " << forged_time << " after " << newest;
-    EXPECT_EQ(tracker.observe(static_cast<std::uint8_t>(i % 16), 5000 + i), Verdict::kInSequence);
+    EXPECT_EQ(tracker.observe_at(i, static_cast<std::uint8_t>(i % 16), 5000 + i), Verdict::kInSequence);
   }
   EXPECT_EQ(tracker.counts(), (Counts{.out_of_sequence = 1000}));
 }
@@ -301,7 +324,7 @@ TEST(SequenceTracker, AGapLongerThanTheInvalidFramesIsStillLost) {
   tracker.observe(4, 5004);
   EXPECT_EQ(tracker.counts(), (Counts{.lost = 2}));
   tracker.observe(2, 5002);  // one of the lost ones arrives late after all
-  EXPECT_EQ(tracker.counts(), (Counts{.lost = 1, .reordered = 1}));
+  EXPECT_EQ(tracker.counts(), (Counts{.lost = 1, .reordered = 1, .out_of_sequence = 1}));
 }
 
 // The simulator holds frame 4 back and sends it after the next one, which it corrupts: the gap
@@ -323,7 +346,7 @@ TEST(SequenceTracker, AFrameHeldBackBehindAnInvalidOneIsReorderedNotDuplicated) 
   tracker.observe(6, 5006);  // 4 and 5 skipped; the invalid one covers one of them
   tracker.observe(4, 5004);  // late
   tracker.observe(7, 5007);
-  EXPECT_EQ(tracker.counts(), (Counts{.reordered = 1}));
+  EXPECT_EQ(tracker.counts(), (Counts{.reordered = 1, .out_of_sequence = 1}));
   // And without time, where only the packet number places a frame.
   Tracker untimed;
   untimed.observe(3, std::nullopt);
@@ -361,7 +384,10 @@ TEST(SequenceTracker, SimulatorFaultPatternWithCorruptionCountsOnlyDropsAsLost) 
     }
     if (held_back) send(*std::exchange(held_back, std::nullopt));
   }
-  EXPECT_EQ(tracker.counts(), (Counts{.lost = dropped, .duplicated = duplicated, .reordered = reordered}));
+  EXPECT_EQ(
+      tracker.counts(),
+      (Counts{
+          .lost = dropped, .duplicated = duplicated, .reordered = reordered, .out_of_sequence = reordered}));
 }
 
 TEST(SequenceTracker, AnInvalidDatagramThatFillsNoGapSoonIsForgotten) {

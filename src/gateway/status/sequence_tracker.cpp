@@ -55,7 +55,9 @@ SequenceTracker::Verdict SequenceTracker::observe(std::uint8_t packet_number,
     advance(ahead == 0 ? kModulo : ahead, packet_number, time_ms, arrival);
     return Verdict::kInSequence;
   }
-  if (*newest_time_ms_ - *time_ms > restart_threshold_ms_)
+  // Earlier by more than a late frame can be, or after the stream fell silent (a robot restarted
+  // soon after its start has times below the old ones for a while): maybe a new sequence.
+  if (*newest_time_ms_ - *time_ms > restart_threshold_ms_ || arrival - newest_arrival_ >= silence_)
     return another_sequence(packet_number, *time_ms, arrival, was_holding);
   // Late: it counts in the sequence (reordered or duplicated), but the stream has moved on.
   const unsigned behind = distance_ahead(packet_number, newest_packet_number_);
@@ -80,11 +82,13 @@ SequenceTracker::Verdict SequenceTracker::another_sequence(std::uint8_t packet_n
                          ahead <= kMaxAheadWithoutTime &&
                          in_step(candidate_time_ms_, candidate_arrival_, time_ms, arrival);
   const unsigned frames = continues ? candidate_frames_ + 1 : 1;
+  const unsigned skipped = continues ? candidate_skipped_ + ahead - 1 : 0;  // in the new sequence
   // While the stream followed so far is still heard, or the new sequence has not gone on, the
   // frame is a replay or a forgery as far as anyone can tell: it changes nothing of the stream's
   // accounting.
   if (arrival - newest_arrival_ < silence_ || frames < kConfirmFrames) {
     candidate_frames_ = frames;
+    candidate_skipped_ = skipped;
     candidate_packet_number_ = packet_number;
     candidate_time_ms_ = time_ms;
     candidate_arrival_ = arrival;
@@ -93,8 +97,13 @@ SequenceTracker::Verdict SequenceTracker::another_sequence(std::uint8_t packet_n
     return Verdict::kHeld;
   }
   ++counts_.restarts;
-  // The new sequence starts at its previous frame, so that what it skipped since counts lost.
+  // The new sequence starts at its previous frame, and what it skipped counts lost (less the
+  // invalid frames that arrived meanwhile, as in advance()).
+  const std::uint64_t credits = invalid_credits_;
   start(candidate_packet_number_, candidate_time_ms_, candidate_arrival_);
+  const std::uint64_t covered = std::min<std::uint64_t>(skipped - (ahead - 1), credits);
+  counts_.lost += skipped - (ahead - 1) - covered;
+  invalid_credits_ = credits - covered;
   advance(ahead, packet_number, time_ms, arrival);
   releases_held_ = was_holding;
   if (releases_held_) --counts_.out_of_sequence;  // the held frame is published after all

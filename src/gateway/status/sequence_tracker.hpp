@@ -132,6 +132,7 @@ class SequenceTracker {
 
   // The newest frame of another sequence, while it may be a restart (`candidate_frames_` > 0).
   unsigned candidate_frames_ = 0;
+  unsigned candidate_skipped_ = 0;  // packet numbers its frames skipped, up to the newest
   std::uint8_t candidate_packet_number_ = 0;
   std::uint64_t candidate_time_ms_ = 0;
   Arrival candidate_arrival_{};
