@@ -112,21 +112,22 @@ void Egress::log_unencodable() {
 }
 
 void Egress::log_refused() {
+  // Each kind is logged when it first happens, then at most every 10 s with what came since.
+  const auto now = Clock::now();
   const std::uint64_t request_like = request_like_.load(std::memory_order_relaxed);
-  const std::uint64_t rate_limited = rate_limited_.load(std::memory_order_relaxed);
-  if ((request_like == logged_request_like_ && rate_limited == logged_rate_limited_) ||
-      !refused_log_.allow(Clock::now()))
-    return;
-  if (request_like != logged_request_like_)
+  if (request_like != logged_request_like_ && request_like_log_.allow(now)) {
     spdlog::warn(
         "{} samples of the egress topic select no field: their frame would read as a selection "
         "request to the robot, so they were not sent",
         request_like - logged_request_like_);
-  if (rate_limited != logged_rate_limited_)
+    logged_request_like_ = request_like;
+  }
+  const std::uint64_t rate_limited = rate_limited_.load(std::memory_order_relaxed);
+  if (rate_limited != logged_rate_limited_ && rate_limited_log_.allow(now)) {
     spdlog::warn("{} samples of the egress topic were not sent: more than --egress-rate {} a second",
                  rate_limited - logged_rate_limited_, max_rate_hz_);
-  logged_request_like_ = request_like;
-  logged_rate_limited_ = rate_limited;
+    logged_rate_limited_ = rate_limited;
+  }
 }
 
 }  // namespace rsg::gateway

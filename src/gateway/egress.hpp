@@ -120,7 +120,8 @@ class Egress {
   LogThrottle unencodable_log_{std::chrono::seconds(1)};
   std::uint64_t logged_request_like_ = 0;
   std::uint64_t logged_rate_limited_ = 0;
-  LogThrottle refused_log_{std::chrono::seconds(10)};
+  LogThrottle request_like_log_{std::chrono::seconds(10)};
+  LogThrottle rate_limited_log_{std::chrono::seconds(10)};
 
   std::thread thread_;  // last: starts once everything it uses exists
 };
