@@ -104,6 +104,13 @@ const std::array kKeys = {
                     return error;
                 return std::string();
               }},
+    ConfigKey{"egress-rate", "Egress samples sent to the robot per second at most, Hz (0: --expected-rate)",
+              &GatewayConfig::egress_rate,
+              [](const GatewayConfig& c) {
+                return c.egress_rate == 0 || (c.egress_rate >= 0.1 && c.egress_rate <= 100000)
+                           ? std::string()
+                           : "must be 0 or in 0.1..100000";
+              }},
     ConfigKey{
         "robot", "HOST:PORT the selection request goes to (default: wherever frames come from, once they do)",
         &GatewayConfig::robot, [](const GatewayConfig& c) { return check_optional_host_port(c.robot); }},

@@ -36,6 +36,7 @@ struct GatewayConfig {
   // TIME_BASED_FILTER, so slow readers cannot ask for a rate themselves)
   std::vector<std::string> rate_topics;
   std::vector<std::string> send_to;
+  double egress_rate = 0;  ///< egress samples sent per second at most; 0: the expected rate
 
   // Selection request to the robot
   std::string robot;

@@ -19,7 +19,10 @@ const rsg::dds::Duration kIdleWake{1, 0};
 
 }  // namespace
 
-Egress::Egress(dds::Participant& participant, const Options& options) : participant_(participant) {
+Egress::Egress(dds::Participant& participant, const Options& options)
+    : participant_(participant),
+      budget_(options.max_rate_hz, options.max_rate_hz * kBurstSeconds),
+      max_rate_hz_(options.max_rate_hz) {
   for (const transport::Endpoint& endpoint : options.destinations)
     destinations_.push_back({endpoint, transport::UdpSocket::for_sending_to(endpoint)});
 
@@ -41,8 +44,9 @@ Egress::~Egress() {
 }  // the owners delete the reader, then the subscriber
 
 EgressCounters Egress::counters() const {
-  return {samples_.load(std::memory_order_relaxed), frames_sent_.load(std::memory_order_relaxed),
-          unencodable_.load(std::memory_order_relaxed), send_failed_.load(std::memory_order_relaxed)};
+  return {samples_.load(std::memory_order_relaxed),      frames_sent_.load(std::memory_order_relaxed),
+          unencodable_.load(std::memory_order_relaxed),  send_failed_.load(std::memory_order_relaxed),
+          request_like_.load(std::memory_order_relaxed), rate_limited_.load(std::memory_order_relaxed)};
 }
 
 std::uint32_t Egress::matched_writers() const {
@@ -57,6 +61,7 @@ void Egress::run() {
     waitset_.wait(triggered, kIdleWake);
     forward_available();
     log_unencodable();
+    log_refused();
   }
 }
 
@@ -79,6 +84,16 @@ void Egress::forward(const RobotState& sample) {
     last_encode_error_ = encoded.error;
     return;
   }
+  // Header and CRC alone: the robot would take it for a selection request (of whatever the
+  // sample selects), not a state.
+  if (encoded.size == wire::kSelectionRequestBytes) {
+    request_like_.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
+  if (!budget_.take(Clock::now())) {
+    rate_limited_.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
   for (Destination& destination : destinations_) {
     if (destination.socket.send_to(std::span(frame_).first(encoded.size), destination.endpoint))
       frames_sent_.fetch_add(1, std::memory_order_relaxed);
@@ -94,6 +109,25 @@ void Egress::log_unencodable() {
                total - logged_unencodable_, to_string(last_encode_error_.category()),
                last_encode_error_.message());
   logged_unencodable_ = total;
+}
+
+void Egress::log_refused() {
+  // Each kind is logged when it first happens, then at most every 10 s with what came since.
+  const auto now = Clock::now();
+  const std::uint64_t request_like = request_like_.load(std::memory_order_relaxed);
+  if (request_like != logged_request_like_ && request_like_log_.allow(now)) {
+    spdlog::warn(
+        "{} samples of the egress topic select no field: their frame would read as a selection "
+        "request to the robot, so they were not sent",
+        request_like - logged_request_like_);
+    logged_request_like_ = request_like;
+  }
+  const std::uint64_t rate_limited = rate_limited_.load(std::memory_order_relaxed);
+  if (rate_limited != logged_rate_limited_ && rate_limited_log_.allow(now)) {
+    spdlog::warn("{} samples of the egress topic were not sent: more than --egress-rate {} a second",
+                 rate_limited - logged_rate_limited_, max_rate_hz_);
+    logged_rate_limited_ = rate_limited;
+  }
 }
 
 }  // namespace rsg::gateway

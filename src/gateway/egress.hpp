@@ -4,8 +4,15 @@
 // ingress. Samples are taken as loans (zero-copy with data-sharing) and encoded into one buffer
 // allocated at start-up. A frame that went raw -> DDS -> raw comes out byte-identical, because
 // the sample keeps the packet number and the selection and the encoder rewrites exactly that.
+//
+// What reaches the robot is bounded, since any participant of the domain may write the egress
+// topic (docs/security.md): at most `max_rate_hz` samples a second (a token bucket that lets
+// kBurst of a second through at once, so a writer's jitter costs nothing), and never a frame the
+// robot would read as something else. A frame with an empty data section (L = 0) is byte for byte
+// a selection request (docs/protocol.md), so such a sample is refused, not sent.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <fastdds/dds/core/condition/GuardCondition.hpp>
@@ -15,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "clock.hpp"
 #include "log_throttle.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
@@ -25,6 +33,28 @@
 
 namespace rsg::gateway {
 
+/// At most `rate` events a second on average, and `burst` at once: a token bucket.
+class RateBudget {
+ public:
+  RateBudget(double rate, double burst) : rate_(rate), burst_(std::max(burst, 1.0)), tokens_(burst_) {}
+
+  /// True (and one token is spent) when an event may happen at `now`.
+  bool take(Clock::time_point now) {
+    const double seconds = std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+    if (seconds > 0) tokens_ = std::min(burst_, tokens_ + seconds * rate_);
+    if (tokens_ < 1) return false;
+    tokens_ -= 1;
+    return true;
+  }
+
+ private:
+  double rate_;
+  double burst_;
+  double tokens_;
+  Clock::time_point last_{};
+};
+
 class Egress {
  public:
   struct Options {
@@ -33,7 +63,12 @@ class Egress {
     std::vector<std::string> partitions;
     std::string reader_profile;
     std::vector<transport::Endpoint> destinations;
+    /// Samples sent per second at most (each to every destination); > 0.
+    double max_rate_hz = 1000;
   };
+
+  /// The share of a second of `max_rate_hz` that may go out at once.
+  static constexpr double kBurstSeconds = 0.1;
 
   /// Creates the reader and the sockets, then starts the thread.
   /// @throws rsg::EnvironmentError when DDS or the kernel refuses the reader or a socket.
@@ -58,6 +93,7 @@ class Egress {
   void forward_available();
   void forward(const RobotState& sample);
   void log_unencodable();
+  void log_refused();
 
   dds::Participant& participant_;
   dds::OwnedSubscriber subscriber_;
@@ -74,10 +110,18 @@ class Egress {
   std::atomic<std::uint64_t> frames_sent_{0};
   std::atomic<std::uint64_t> unencodable_{0};
   std::atomic<std::uint64_t> send_failed_{0};
+  std::atomic<std::uint64_t> request_like_{0};
+  std::atomic<std::uint64_t> rate_limited_{0};
+  RateBudget budget_;  // egress thread only
+  double max_rate_hz_;
   // Egress thread only: the rate-limited log of samples that are no valid frame.
   wire::FrameError last_encode_error_;
   std::uint64_t logged_unencodable_ = 0;
   LogThrottle unencodable_log_{std::chrono::seconds(1)};
+  std::uint64_t logged_request_like_ = 0;
+  std::uint64_t logged_rate_limited_ = 0;
+  LogThrottle request_like_log_{std::chrono::seconds(10)};
+  LogThrottle rate_limited_log_{std::chrono::seconds(10)};
 
   std::thread thread_;  // last: starts once everything it uses exists
 };

@@ -236,6 +236,7 @@ GatewaySetup prepare(const GatewayConfig& config) {
     egress.reader_profile = config.reader_profile;
     for (const auto& destination : config.send_to)
       egress.destinations.push_back(resolve("send-to", destination));
+    egress.max_rate_hz = config.egress_rate > 0 ? config.egress_rate : config.expected_rate;
     setup.egress = std::move(egress);
   }
   if (!config.metrics.empty()) setup.metrics = resolve("metrics", config.metrics);

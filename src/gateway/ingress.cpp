@@ -70,7 +70,7 @@ Ingress::Ingress(dds::Participant& participant, Options options)
       socket_(transport::UdpSocket::bind(options_.listen)),
       participant_(participant),
       batch_(kBatchDatagrams, wire::kMaxFrameBytes),
-      sequence_(options_.restart_threshold_ms),
+      sequence_(options_.restart_threshold_ms, LinkMonitor(options_.nominal_period).silence_limit()),
       link_(options_.nominal_period) {
   // The link monitor and the delay counters judge by when frames arrived, not by when a busy
   // ingress got round to them.
@@ -166,7 +166,20 @@ void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::
 
   const std::optional<std::uint64_t> robot_time_ms = frame_time(frame, slot.sample());
   const std::uint64_t restarts = sequence_.counts().restarts;
-  sequence_.observe(frame.packet_number(), robot_time_ms);
+  // A frame that does not continue the stream (late, replayed, forged: sequence_tracker.hpp) is
+  // counted there and goes no further: no consumer, rate topic or link state sees it. The one that
+  // may start a restarted sequence is kept, to go out first should the next frame confirm it.
+  switch (sequence_.observe(frame.packet_number(), robot_time_ms, arrival)) {
+    case SequenceTracker::Verdict::kOutOfSequence:
+      return;
+    case SequenceTracker::Verdict::kHeld:
+      held_sample_ = slot.sample();  // a plain copy into storage allocated at start-up
+      held_selection_ = frame.selection();
+      held_time_ms_ = robot_time_ms;
+      return;
+    case SequenceTracker::Verdict::kInSequence:
+      break;
+  }
   if (sequence_.counts().restarts != restarts)  // the robot's clock began again: so do the ages
     age_floor_ns_ = age_floor_last_ns_ = kNoFloor;
   link_came_up_ |= link_.on_frame(arrival);
@@ -174,20 +187,12 @@ void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::
   if (requester_ && requester_->due(frame.selection(), now))
     request_selection(options_.robot ? *options_.robot : datagram.from, now);
 
-  if (options_.on_sample) options_.on_sample(slot.sample());
-  // Before the full-rate write, which hands a loaned sample over to the middleware. The slower
-  // outputs are paced by the robot's time when the frame carries it, else by arrival.
-  if (!rate_writers_.empty() || standard_topics_) {
-    const std::chrono::nanoseconds t =
-        robot_time_ms ? std::chrono::nanoseconds(std::chrono::milliseconds(*robot_time_ms))
-                      : std::chrono::nanoseconds(now.time_since_epoch());
-    if (!rate_writers_.empty()) write_rate_topics(slot.sample(), t);
-    if (standard_topics_) standard_topics_->offer(slot.sample(), frame.selection(), t);
+  if (sequence_.releases_held()) {
+    deliver(held_sample_, held_selection_, held_time_ms_, now);
+    count_write(dds::succeeded(writer_->write(&held_sample_)));  // a copy into the writer's history
   }
-  if (slot.write())
-    ++counters_.published;
-  else
-    ++counters_.publish_failed;
+  deliver(slot.sample(), frame.selection(), robot_time_ms, now);
+  count_write(slot.write());
   const auto published = Clock::now();
   const auto delay = published - arrival;
   delay_period_max_ = std::max(delay_period_max_, delay);
@@ -205,6 +210,26 @@ void Ingress::record_age(std::uint64_t robot_time_ms, Clock::time_point arrival,
   age_floor_ns_ = std::min(age_floor_ns_, ns(arrival) - robot_ns);
   const std::int64_t floor = std::min(age_floor_ns_, age_floor_last_ns_);
   age_histogram_.record(std::chrono::nanoseconds(ns(published) - robot_ns - floor));
+}
+
+void Ingress::deliver(const RobotState& sample, const wire::Selection& selection,
+                      std::optional<std::uint64_t> robot_time_ms, Clock::time_point now) {
+  if (options_.on_sample) options_.on_sample(sample);
+  // Before the full-rate write, which hands a loaned sample over to the middleware. The slower
+  // outputs are paced by the robot's time when the frame carries it, else by arrival.
+  if (rate_writers_.empty() && !standard_topics_) return;
+  const std::chrono::nanoseconds t = robot_time_ms
+                                         ? std::chrono::nanoseconds(std::chrono::milliseconds(*robot_time_ms))
+                                         : std::chrono::nanoseconds(now.time_since_epoch());
+  if (!rate_writers_.empty()) write_rate_topics(sample, t);
+  if (standard_topics_) standard_topics_->offer(sample, selection, t);
+}
+
+void Ingress::count_write(bool written) {
+  if (written)
+    ++counters_.published;
+  else
+    ++counters_.publish_failed;
 }
 
 void Ingress::write_rate_topics(const RobotState& sample, std::chrono::nanoseconds t) {

@@ -127,6 +127,10 @@ class Ingress {
   void request_selection(const transport::Endpoint& robot, Clock::time_point now);
   void write_rate_topics(const RobotState& sample, std::chrono::nanoseconds t);
   void record_age(std::uint64_t robot_time_ms, Clock::time_point arrival, Clock::time_point published);
+  // The consumer, rate topics and standard topics: every output but the full-rate write.
+  void deliver(const RobotState& sample, const wire::Selection& selection,
+               std::optional<std::uint64_t> robot_time_ms, Clock::time_point now);
+  void count_write(bool written);
 
   // A downsampled writer: writes the frames its decimator takes.
   struct RateWriter {
@@ -148,6 +152,10 @@ class Ingress {
   transport::DatagramBatch batch_;
   dds::RobotStateCodec codec_;
   RobotState fallback_sample_;  // when the writer cannot loan: the one preallocated sample
+  // The frame SequenceTracker holds (a possible restart), published first if the next confirms it.
+  RobotState held_sample_;
+  wire::Selection held_selection_;
+  std::optional<std::uint64_t> held_time_ms_;
 
   IngressCounters counters_;
   SequenceTracker sequence_;

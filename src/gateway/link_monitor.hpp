@@ -39,6 +39,8 @@ class LinkMonitor {
   }
 
   bool up() const { return up_; }
+  /// How long without a valid frame takes the link down.
+  Clock::duration silence_limit() const { return silence_limit_; }
   /// When `poll()` would next report the link down; far future while it is down.
   Clock::time_point deadline() const { return up_ ? last_frame_ + silence_limit_ : Clock::time_point::max(); }
 

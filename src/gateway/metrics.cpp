@@ -42,6 +42,9 @@ constexpr Family kDuplicated{"rsg_frames_duplicated_total", Type::kCounter, "Fra
 constexpr Family kReordered{"rsg_frames_reordered_total", Type::kCounter, "Frames received out of order"};
 constexpr Family kRestarts{"rsg_robot_restarts_total", Type::kCounter,
                            "Times the robot's time went back by more than --restart-threshold-ms"};
+constexpr Family kOutOfSequence{
+    "rsg_frames_out_of_sequence_total", Type::kCounter,
+    "Valid frames not published: their time went back or jumped ahead of the clock"};
 constexpr Family kStandardDropped{"rsg_standard_topics_dropped_total", Type::kCounter,
                                   "Snapshots the ROS 2 standard topics' thread dropped behind"};
 constexpr Family kEgressSamples{"rsg_egress_samples_total", Type::kCounter,
@@ -52,6 +55,11 @@ constexpr Family kEgressUnencodable{"rsg_egress_unencodable_total", Type::kCount
                                     "Egress samples that describe no valid frame"};
 constexpr Family kEgressSendFailed{"rsg_egress_send_failed_total", Type::kCounter,
                                    "Egress datagrams the socket refused"};
+constexpr Family kEgressRequestLike{
+    "rsg_egress_request_like_total", Type::kCounter,
+    "Egress samples not sent: the robot would read them as a selection request"};
+constexpr Family kEgressRateLimited{"rsg_egress_rate_limited_total", Type::kCounter,
+                                    "Egress samples not sent: above --egress-rate"};
 constexpr Family kDumps{
     "rsg_flight_recorder_dumps_total", Type::kCounter,
     "Flight-recorder dumps by result: written, failed (the file could not be written), "
@@ -106,11 +114,14 @@ constexpr std::array kFamilies = {&kBuildInfo,
                                   &kDuplicated,
                                   &kReordered,
                                   &kRestarts,
+                                  &kOutOfSequence,
                                   &kStandardDropped,
                                   &kEgressSamples,
                                   &kEgressSent,
                                   &kEgressUnencodable,
                                   &kEgressSendFailed,
+                                  &kEgressRequestLike,
+                                  &kEgressRateLimited,
                                   &kDumps,
                                   &kDumpFilesDeleted,
                                   &kDumpNotKept,
@@ -283,11 +294,14 @@ std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<
   out.one(kDuplicated, stats.sequence.duplicated);
   out.one(kReordered, stats.sequence.reordered);
   out.one(kRestarts, stats.sequence.restarts);
+  out.one(kOutOfSequence, stats.sequence.out_of_sequence);
   out.one(kStandardDropped, stats.standard_dropped);
   out.one(kEgressSamples, stats.egress.samples);
   out.one(kEgressSent, stats.egress.frames_sent);
   out.one(kEgressUnencodable, stats.egress.unencodable);
   out.one(kEgressSendFailed, stats.egress.send_failed);
+  out.one(kEgressRequestLike, stats.egress.request_like);
+  out.one(kEgressRateLimited, stats.egress.rate_limited);
   if (const auto& dumps = snapshot.dumps) {
     out.family(kDumps);
     out.sample(kDumps, dumps->written, "result=\"written\"");

@@ -102,6 +102,8 @@ void Ros2StandardTopics::create(Writer& writer, const std::optional<Output>& out
   fdds::Topic* topic = participant_.topic(output->topic, type);
   fdds::DataWriterQos qos = writer_qos(publisher_);
   announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
+  // As every writer of the gateway (create_writer_with_profile): no reader's filter runs here.
+  rsg::dds::leave_filtering_to_readers(qos);
   writer.writer =
       dds::own(publisher_, publisher_.create_datawriter(topic, qos), "the writer of '" + output->topic + "'");
   writer.decimator.emplace(output->decimation);
@@ -115,6 +117,13 @@ std::uint32_t Ros2StandardTopics::matched_readers() const {
       readers += static_cast<std::uint32_t>(matched.current_count);
   }
   return readers;
+}
+
+std::vector<const fdds::DataWriter*> Ros2StandardTopics::writers() const {
+  std::vector<const fdds::DataWriter*> on;
+  for (const Writer* output : {&joint_states_, &tf_, &wrench_})
+    if (output->writer) on.push_back(output->writer.get());
+  return on;
 }
 
 std::array<std::uint64_t, 3> Ros2StandardTopics::written() const {

@@ -65,6 +65,8 @@ class Ros2StandardTopics {
   std::uint32_t matched_readers() const;
   /// Messages written so far, per output (joint_states, tf, external_wrench).
   std::array<std::uint64_t, 3> written() const;
+  /// The writers of the outputs that are on (joint_states, tf, external_wrench order): their QoS.
+  std::vector<const eprosima::fastdds::dds::DataWriter*> writers() const;
 
   static constexpr std::size_t kRingSlots = 64;
 

@@ -51,10 +51,12 @@ class Probe:
     The probe lives until its standard input closes; stop() closes it, and kills the probe if it
     does not leave in time."""
 
-    def __init__(self, name, mode, profiles, profile, domain, partition, marker=False):
+    def __init__(self, name, mode, profiles, profile, domain, partition, marker=False, topic=None):
         self.name = name
         command = [ARGS.probe, mode, "--profile", profile, "--domain", str(domain), "--partition", partition,
                    "--samples", str(SAMPLES)]
+        if topic:
+            command += ["--topic", topic]
         for file in profiles:
             command += ["--profiles", str(file)]
         if marker:
@@ -279,9 +281,9 @@ class Security(unittest.TestCase):
         self.pki = self.work / "pki"
         self.secure_profiles = make_pki(self.pki)
 
-    def start(self, name, mode, profile, profiles=None, marker=False):
+    def start(self, name, mode, profile, profiles=None, marker=False, topic=None):
         probe = Probe(name, mode, profiles or [self.secure_profiles], profile, self.domain, self.partition,
-                      marker)
+                      marker, topic)
         self.addCleanup(probe.stop)
         return probe
 
@@ -328,6 +330,57 @@ class Security(unittest.TestCase):
         # a participant that was never there.
         gateway.wait_for_authentication(plain.participant, "unauthorized")
         self.assert_kept_out(plain, gateway, self.permitted_reader())
+
+    # docs/security.md, "What an attacker on the network can and cannot do": a participant without
+    # a certificate can neither write robot_state or rsg_gateway_status nor read them. Its writers
+    # carry the marker, so any of its samples that got through would not be exact.
+    def plain(self, name, mode, topic):
+        probe = self.start(name, mode, "rsg_plain_udp", profiles=[ARGS.plain_profiles], marker=True, topic=topic)
+        self.assertTrue(probe.ready()["endpoint_created"], probe.report())
+        return probe
+
+    def test_unauthenticated_writer_of_robot_state_is_not_matched(self):
+        gateway = self.gateway()
+        forger = self.plain("forger", "publish", "robot_state")
+        gateway.wait_for_authentication(forger.participant, "unauthorized")
+        reader = self.permitted_reader()
+        self.assert_kept_out(forger, gateway, reader)
+        self.assertEqual(reader.matched_participants(), {gateway.participant}, reader.report())
+        self.assertTrue(all(sample["exact"] for sample in reader.events("sample")), reader.report())
+
+    def status_endpoint(self, name, mode, profile):
+        """A secure probe on rsg_gateway_status: the gateway identity publishes it, the intruder
+        identity may subscribe it (with RobotState's type, as the forger's)."""
+        probe = self.start(name, mode, profile, topic="rsg_gateway_status")
+        self.assertTrue(probe.ready()["endpoint_created"], probe.report())
+        return probe
+
+    def test_unauthenticated_writer_of_gateway_status_is_not_matched(self):
+        # The same type as the genuine writer's, so that only security, not a type mismatch, keeps
+        # the forger out.
+        status = self.status_endpoint("gateway", "publish", "rsg_secure_gateway")
+        forger = self.plain("forger", "publish", "rsg_gateway_status")
+        status.wait_for_authentication(forger.participant, "unauthorized")
+        monitor = self.status_endpoint("monitor", "subscribe", "rsg_secure_intruder")
+        self.assert_kept_out(forger, status, monitor)
+        self.assertEqual(monitor.matched_participants(), {status.participant}, monitor.report())
+        self.assertTrue(all(sample["exact"] for sample in monitor.events("sample")), monitor.report())
+
+    def test_unauthenticated_reader_of_gateway_status_is_not_matched(self):
+        status = self.status_endpoint("gateway", "publish", "rsg_secure_gateway")
+        eavesdropper = self.plain("eavesdropper", "subscribe", "rsg_gateway_status")
+        status.wait_for_authentication(eavesdropper.participant, "unauthorized")
+        self.assert_kept_out(eavesdropper, status, self.status_endpoint("monitor", "subscribe", "rsg_secure_intruder"))
+
+    def test_open_domain_lets_anyone_write_gateway_status(self):
+        # The control: without DDS Security, a participant writes rsg_gateway_status (here with
+        # RobotState's layout) and any reader of that topic and type takes it as the gateway's.
+        forger = self.start("forger", "publish", "rsg_plain_udp", profiles=[ARGS.plain_profiles],
+                            topic="rsg_gateway_status")
+        reader = self.start("reader", "subscribe", "rsg_plain_udp", profiles=[ARGS.plain_profiles],
+                            topic="rsg_gateway_status")
+        self.assert_receives_every_sample_exactly(reader)
+        self.assertEqual(reader.matched_participants(), {forger.participant}, reader.report())
 
     def test_intruder_without_read_permission_is_refused(self):
         gateway = self.gateway()

@@ -14,13 +14,34 @@
 //     - time later than the newest: ahead by d (d = 0 meaning a full wrap, 16);
 //     - time earlier by at most `restart_threshold_ms`: behind by (newest_pn - pn) mod 16
 //       (0 meaning 16);
-//     - time earlier by more: a robot restart.
+//     - time earlier by more: a restart of the robot, or a frame of another stream (see below).
 //   * Ahead by d: the d-1 frames skipped are counted lost (a gap longer than 16 frames cannot be
 //     told from a shorter one: packet numbers only count modulo 16; a pause where the robot sends
 //     nothing while its time runs on is not a loss).
 //   * Behind: a bit window of the last 64 positions says whether that frame arrived already. If
 //     it did, the frame is a duplicate; if not, it arrives late: reordered, and no longer lost.
 //   * Restart: counted, and the frame starts a fresh sequence (nothing lost across a restart).
+//
+// With `time`, the tracker also says which frames continue the stream, so that only those are
+// published (observe() returns the verdict). The robot's `time` increases strictly (docs/protocol.md),
+// and a controller that reads the newest sample must never be taken back in time, so a frame
+// whose time is earlier than that of the newest frame is counted `out_of_sequence` and not
+// published: a late frame (still counted reordered or duplicated as above), a replayed one, or
+// one interleaved by a forger. So is a frame whose time jumps further ahead than the arrival
+// clock has run since the newest frame, plus a jitter allowance (`silence`): the robot's clock
+// and the host's run at the same rate, a forged frame from the future need not.
+//
+// A restart is believed only when nothing else explains the jump: a frame of another sequence
+// continues the one before it (later time, the next packet numbers, both clocks in step), and the
+// stream followed so far has been silent for `silence` (what takes the link down, link_monitor.hpp).
+// The frame of the new sequence before the one that confirms it is held (observe() says kHeld) and
+// published first once the restart is believed, so a robot that reboots after a pause loses no
+// frame. A replayed or forged frame interleaved with the robot's stream therefore never counts as a
+// restart, nor shifts the packet numbers the stream's losses are counted from; only a sender that
+// outlasts the robot's own silence can start a new sequence. A robot that starts a new sequence
+// without a pause has its first frames counted out_of_sequence until its old stream has been
+// silent for that long. Frames without `time` cannot be told apart this way: every one is
+// published and only the packet-number rules above apply.
 //
 // An invalid frame (rejected by the decoder, so its packet number cannot be trusted) is counted
 // under its category, not as lost: `on_invalid()` notes it, and the next gaps ahead absorb one
@@ -32,6 +53,7 @@
 // sender), as far as the packet numbers can tell.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <optional>
 
@@ -44,15 +66,31 @@ class SequenceTracker {
     std::uint64_t duplicated = 0;
     std::uint64_t reordered = 0;
     std::uint64_t restarts = 0;
+    /// Valid frames not published: their time went back, or jumped ahead beyond the arrival clock.
+    std::uint64_t out_of_sequence = 0;
 
     friend bool operator==(const Counts&, const Counts&) = default;
   };
 
-  /// `restart_threshold_ms`: how far `time` must go backwards to be a restart, not a late frame.
-  explicit SequenceTracker(std::uint64_t restart_threshold_ms = 100);
+  /// When a frame arrived (the gateway's steady clock).
+  using Arrival = std::chrono::steady_clock::time_point;
+  static constexpr std::chrono::milliseconds kDefaultSilence{10};
 
-  /// Accounts one valid frame; `time_ms` is its `time` field when the frame carries one.
-  void observe(std::uint8_t packet_number, std::optional<std::uint64_t> time_ms) noexcept;
+  /// Whether a frame continues the stream (publish it) or not (drop it), or may be the first of a
+  /// restarted sequence (keep it: if the next frame confirms the restart, publish it first).
+  enum class Verdict : std::uint8_t { kInSequence, kOutOfSequence, kHeld };
+  /// Frames of another sequence that confirm it, the first one included.
+  static constexpr unsigned kConfirmFrames = 2;
+
+  /// `restart_threshold_ms`: how far `time` must go backwards to be a restart, not a late frame.
+  /// `silence`: how long the stream must have been silent before a frame of another sequence is
+  /// believed to be the robot's restart; also how far `time` may run ahead of the arrival clock.
+  explicit SequenceTracker(std::uint64_t restart_threshold_ms = 100,
+                           std::chrono::steady_clock::duration silence = kDefaultSilence);
+
+  /// Accounts one valid frame that arrived at `arrival`; `time_ms` is its `time` field when the
+  /// frame carries one.
+  Verdict observe(std::uint8_t packet_number, std::optional<std::uint64_t> time_ms, Arrival arrival) noexcept;
 
   /// Accounts one datagram the decoder rejected: it arrived, so the gap it leaves is not a loss.
   void on_invalid() noexcept {
@@ -60,25 +98,46 @@ class SequenceTracker {
     frames_since_invalid_ = 0;
   }
 
+  /// After a kInSequence verdict: the frame held just before is published first (the restart it
+  /// began is believed). A held frame counts out_of_sequence until then.
+  bool releases_held() const { return releases_held_; }
+
   const Counts& counts() const { return counts_; }
 
  private:
-  void start(std::uint8_t packet_number, std::optional<std::uint64_t> time_ms) noexcept;
-  void advance(unsigned distance, std::uint8_t packet_number, std::optional<std::uint64_t> time_ms) noexcept;
+  void start(std::uint8_t packet_number, std::optional<std::uint64_t> time_ms, Arrival arrival) noexcept;
+  void advance(unsigned distance, std::uint8_t packet_number, std::optional<std::uint64_t> time_ms,
+               Arrival arrival) noexcept;
+  Verdict another_sequence(std::uint8_t packet_number, std::uint64_t time_ms, Arrival arrival,
+                           bool was_holding) noexcept;
+  bool in_step(std::uint64_t from_ms, Arrival from_arrival, std::uint64_t to_ms,
+               Arrival to_arrival) const noexcept;
   void arrive_late(unsigned age) noexcept;
   bool is_missing(unsigned age) const noexcept;
 
   std::uint64_t restart_threshold_ms_;
+  std::chrono::steady_clock::duration silence_;
   Counts counts_;
   bool started_ = false;
   std::uint8_t newest_packet_number_ = 0;
   std::optional<std::uint64_t> newest_time_ms_;
+  Arrival newest_arrival_{};       // of the newest frame in sequence: when the stream was last heard
+  Arrival newest_time_arrival_{};  // of the newest frame in sequence that carried `time`
   // Bit a set: the frame `a` places behind the newest one has arrived (bit 0: the newest itself).
   std::uint64_t arrived_ = 0;
   // Bit a set: the missing frame `a` places behind the newest is covered by an invalid frame.
   std::uint64_t covered_ = 0;
   std::uint64_t invalid_credits_ = 0;  // invalid frames not yet matched with a gap
   unsigned frames_since_invalid_ = 0;
+
+  // The newest frame of another sequence, while it may be a restart (`candidate_frames_` > 0).
+  unsigned candidate_frames_ = 0;
+  unsigned candidate_skipped_ = 0;  // packet numbers its frames skipped, up to the newest
+  std::uint8_t candidate_packet_number_ = 0;
+  std::uint64_t candidate_time_ms_ = 0;
+  Arrival candidate_arrival_{};
+  bool holding_ = false;  // the last frame observed was held
+  bool releases_held_ = false;
 };
 
 }  // namespace rsg::gateway

@@ -32,10 +32,13 @@ std::string to_json(const GatewayStats& stats) {
       {"duplicated", stats.sequence.duplicated},
       {"reordered", stats.sequence.reordered},
       {"robot_restarts", stats.sequence.restarts},
+      {"out_of_sequence", stats.sequence.out_of_sequence},
       {"egress_samples", stats.egress.samples},
       {"egress_frames_sent", stats.egress.frames_sent},
       {"egress_unencodable", stats.egress.unencodable},
       {"egress_send_failed", stats.egress.send_failed},
+      {"egress_request_like", stats.egress.request_like},
+      {"egress_rate_limited", stats.egress.rate_limited},
       {"standard_dropped", stats.standard_dropped},
       {"ingress_delay_us", stats.ingress_delay_us},
       {"ingress_delay_max_us", stats.ingress_delay_max_us},
@@ -57,16 +60,18 @@ std::string summary_line(const GatewayStats& stats) {
   const auto& in = stats.ingress;
   std::string line = fmt::format(
       "link {} from {} at {:.1f} Hz; received {} published {} invalid {}{}{}{} rejected_source {}; "
-      "lost {} duplicated {} reordered {} robot_restarts {}",
+      "lost {} duplicated {} reordered {} robot_restarts {} out_of_sequence {}",
       stats.link_up ? "up" : "down", stats.source.empty() ? "(nobody yet)" : stats.source, stats.rate_hz,
       in.received, in.published, in.invalid_total(), in.invalid_total() ? " (" : "",
       format_invalid(in.invalid), in.invalid_total() ? ")" : "", in.rejected_source, stats.sequence.lost,
-      stats.sequence.duplicated, stats.sequence.reordered, stats.sequence.restarts);
+      stats.sequence.duplicated, stats.sequence.reordered, stats.sequence.restarts,
+      stats.sequence.out_of_sequence);
   if (in.publish_failed) line += fmt::format("; publish_failed {}", in.publish_failed);
   const auto& out = stats.egress;
   if (out.samples || out.unencodable)
-    line += fmt::format("; egress samples {} sent {} unencodable {} send_failed {}", out.samples,
-                        out.frames_sent, out.unencodable, out.send_failed);
+    line += fmt::format(
+        "; egress samples {} sent {} unencodable {} send_failed {} request_like {} rate_limited {}",
+        out.samples, out.frames_sent, out.unencodable, out.send_failed, out.request_like, out.rate_limited);
   if (stats.standard_dropped) line += fmt::format("; standard_dropped {}", stats.standard_dropped);
   line +=
       fmt::format("; ingress delay {} us (max {} us)", stats.ingress_delay_us, stats.ingress_delay_max_us);

@@ -39,6 +39,10 @@ struct EgressCounters {
   std::uint64_t frames_sent = 0;  ///< datagrams sent, one per sample and destination
   std::uint64_t unencodable = 0;  ///< samples that do not describe a valid frame
   std::uint64_t send_failed = 0;
+  /// Samples not sent because the robot would read their frame as a selection request (L = 0).
+  std::uint64_t request_like = 0;
+  /// Samples not sent because egress was at its rate limit (--egress-rate).
+  std::uint64_t rate_limited = 0;
 };
 
 struct GatewayStats {
