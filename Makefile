@@ -39,7 +39,7 @@ SHELL      := /bin/bash
 .SHELLFLAGS := -o pipefail -c
 
 
-.PHONY: all deps deps-run build build-demo install test test-long test-jazzy unit-asan fuzz fuzz-build demo bench format clean wireshark-plugin
+.PHONY: all deps deps-run build build-tests build-demo install test test-long test-jazzy unit-asan fuzz fuzz-build demo bench format clean wireshark-plugin
 
 all: build
 
@@ -77,7 +77,15 @@ deps: deps-run
 OPT_FLAGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG" \
              "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG"
 
-build: deps
+# The product, what make install installs, with only the build and run packages (no npm, Python
+# environments or Go: those are the tests'): the tests left unconfigured on a fresh tree, as for the
+# demo, and kept on a tree that has them (make build-tests).
+build: deps-run
+	cmake -S . -B $(BUILD) $(call generator,$(BUILD)) $(OPT_FLAGS) $(if $(wildcard $(BUILD)/CMakeCache.txt),,-DRSG_BUILD_TESTS=OFF) $(CMAKE_COMMON)
+	cmake --build $(BUILD) -j $(JOBS)
+
+# The product and every test and benchmark, with everything the tests need (make deps).
+build-tests: deps
 	cmake -S . -B $(BUILD) $(call generator,$(BUILD)) $(OPT_FLAGS) -DRSG_BUILD_TESTS=ON $(CMAKE_COMMON)
 	cmake --build $(BUILD) -j $(JOBS)
 
@@ -103,7 +111,7 @@ fuzz: fuzz-build
 
 # What a contributor runs: every ctest test but those labelled long or jazzy, side by side; the unit tests
 # again under ASan+UBSan; every fuzzer for TEST_FUZZ_SECONDS (docs/development.md has the time each part takes).
-test: build
+test: build-tests
 	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -LE 'long|jazzy' 2>&1 | tee ctest.log
 	$(MAKE) unit-asan
 	$(MAKE) fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS)
@@ -111,21 +119,23 @@ test: build
 
 # The long scenarios (ctest label long: network namespaces, reliability under load, churn and
 # scale), most of them RUN_SERIAL; .ci/run runs it after make test.
-test-long: build
+test-long: build-tests
 	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -L long 2>&1 | tee ctest-long.log
 	@tests/summarize.sh $(BUILD)/ctest-long.log --
 
 # The rclpy tests again with ROS 2 Jazzy nodes (ctest label jazzy, tests/ros2/CMakeLists.txt: rclpy
 # 7.1 on Fast DDS 2.14 from make deps' .deps/ros2-jazzy against the gateway); make test runs them
 # with Kilted's. A part of its own in .ci/run: together they would exceed make test's time budget.
-test-jazzy: build
+test-jazzy: build-tests
 	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -L jazzy 2>&1 | tee ctest-jazzy.log
 	@tests/summarize.sh $(BUILD)/ctest-jazzy.log --
 
 # Only what the demo runs, with only the build and run packages: in $(BUILD) with its flags, the
 # tests left unconfigured on a fresh tree (no GTest or benchmark needed yet) and kept on a tree
 # that has them, so that a later `make test` reuses every object the demo compiled.
-DEMO_TARGETS := rsg_gateway rsg_sim rsg_echo rsg_view
+# With the demo's four, the other tools a user meets next (record and replay, rsg_frame), so that
+# every tool the guides name is there after the demo.
+DEMO_TARGETS := rsg_gateway rsg_sim rsg_echo rsg_view rsg_record rsg_replay rsg_frame
 build-demo: deps-run
 	cmake -S . -B $(BUILD) $(call generator,$(BUILD)) $(OPT_FLAGS) $(if $(wildcard $(BUILD)/CMakeCache.txt),,-DRSG_BUILD_TESTS=OFF) $(CMAKE_COMMON)
 	cmake --build $(BUILD) -j $(JOBS) --target $(DEMO_TARGETS)
@@ -133,7 +143,7 @@ build-demo: deps-run
 demo: build-demo
 	src/tools/demo.sh $(BUILD)/bin
 
-bench: build
+bench: build-tests
 	tests/bench/run_bench.sh $(BUILD)
 
 # The SEND_BUF dissector into Wireshark's personal Lua plugins folder (where `tshark -G folders` says).
@@ -157,11 +167,11 @@ clean:
 # Fast DDS 3 (Debian 13's 3.1.2) in a cached trixie chroot, and across versions with $(BUILD)'s
 # 2.9.1 on the host (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/.
 .PHONY: test-fastdds3 bench-fastdds3
-test-fastdds3: build
+test-fastdds3: build-tests
 	JOBS=$(JOBS) tests/fastdds3/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds3.log
 
 # make bench's e2e suite on 2.9 (host) and 3.x (chroot) back to back, side by side (docs/benchmarks/fastdds3/).
-bench-fastdds3: build
+bench-fastdds3: build-tests
 	JOBS=$(JOBS) tests/fastdds3/bench.sh $(BUILD)
 
 # The container image (docs/container.md) with the engine that works here: Docker when `docker info`

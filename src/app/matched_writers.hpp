@@ -70,6 +70,9 @@ class MatchedWriters {
     }
   }
 
+  /// Whether any writer has matched since start-up (as of the last update()).
+  bool ever_matched() const { return ever_matched_; }
+
   /// A sample arrived: the reader is not silent.
   void on_sample() { sampled_ = true; }
 

@@ -429,7 +429,7 @@ def view_and_restart(c):
 # What the compose runner below understands of a service; any other key fails the test, so that
 # compose.yaml cannot grow a setting this test would silently leave out.
 COMPOSE_KEYS = {"image", "build", "network_mode", "ipc", "entrypoint", "command", "volumes", "restart", "depends_on",
-                "environment"}
+                "environment", "logging"}
 
 
 def compose_services(path, env):
@@ -467,6 +467,13 @@ def compose_up(c, project, env):
                 args += [flag, service[key]]
         for variable in service.get("environment", []):
             args += ["-e", variable]
+        # Docker's json-file log with a size limit is podman's k8s-file with max-size (podman keeps
+        # no count of rotated files).
+        logging = service.get("logging", {})
+        check(logging.get("driver") == "json-file", f"compose.yaml: log driver {logging.get('driver')}")
+        args += ["--log-driver", "k8s-file"]
+        if "max-size" in logging.get("options", {}):
+            args += ["--log-opt", f"max-size={logging['options']['max-size']}"]
         for volume in service.get("volumes", []):
             source, target = volume.split(":", 1)
             args += ["-v", f"{project}_{source}:{target}" if source in volumes else volume]

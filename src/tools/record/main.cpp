@@ -2,14 +2,16 @@
 // every sample to an MCAP file as the CDR bytes a DDS writer sends, with the schema to decode them.
 //
 // Exit status: 0 after --duration or on SIGINT/SIGTERM with the file finished; 1 when the file
-// cannot be written (the error names it; what was recorded stays readable) or DDS fails; 2 on
+// cannot be written (the error names it; what was recorded stays readable), DDS fails or no writer
+// of the topic ever matched (a wrong domain or partition: the file holds no state); 2 on
 // usage errors (including unknown profiles). With --recover FILE: 0 when FILE was read to its end
 // or cut off (a killed recorder's file), 1 when it is damaged inside or --out cannot be written.
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <deque>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <map>
+#include <limits>
 #include <optional>
 
 #include "dds/internal/fastdds_compat.hpp"
@@ -20,6 +22,7 @@
 #include "monitor_options.hpp"
 #include "monitor_readers.hpp"
 #include "recording.hpp"
+#include "recording_order.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
@@ -38,12 +41,20 @@ using namespace rsg::app;  // the main skeleton and the exit statuses
 // needs no low latency, and a thousand thread wake-ups a second were most of its CPU at 1 kHz. The
 // reader's history (reader_logger: 5000 samples) holds far more than 10 ms at any rate rsg reaches.
 constexpr auto kBatchPeriod = std::chrono::milliseconds(10);
+// How long a sample waits for the samples published before it (recording_order.hpp): a reader that
+// joins a running gateway gets the writer's history after the live samples, later still on a busy
+// host. Longer costs memory (this much of the stream) and what a SIGKILL loses.
+constexpr auto kHold = std::chrono::milliseconds(500);
 
 struct Options : rsg::app::MonitorOptions {
   fs::path out;
   std::string profile;  // MCAP flavour: "" (omgidl) or "ros2"
   double duration_s = 0;
   double split_mb = 0;
+  // Retention of the split files (0: no limit), oldest removed first.
+  std::size_t max_files = 0;
+  double max_mb = 0;
+  double max_age_s = 0;
   std::size_t chunk_bytes = rsg::mcap::WriterOptions{}.chunk_bytes;
   bool fsync = false;
   fs::path recover;  // --recover: copy this damaged file to --out instead of recording
@@ -56,49 +67,39 @@ std::uint64_t now_ns() {
 }
 
 /// One MCAP file after another (with --split-size), each complete with its own schemas and channels.
+/// Samples are written in publication order (PublicationOrder: held until `kHold` after their
+/// arrival), their log times raised where that order puts a later-received sample first.
 class Recording {
  public:
   Recording(const Options& options, rsg::app::Profile profile)
       : options_(options),
         profile_(profile),
-        split_bytes_(static_cast<std::uint64_t>(options.split_mb * 1e6)) {
+        split_bytes_(static_cast<std::uint64_t>(options.split_mb * 1e6)),
+        order_(kHold) {
     open();
   }
 
-  /// Adds a sample to the batch that write_batch() writes.
+  /// Adds a sample to those waiting for their place in the file.
   void add_state(const rsg::RobotState& sample, const fdds::SampleInfo& info) {
     ++states;
-    add(channels_.robot_state, serializer_.serialize(sample), info);
+    // A view's filter leaves holes in the writer's sequence numbers on purpose.
+    add(channels_.robot_state, options_.view_profile.empty(), serializer_.serialize(sample), info);
   }
   void add_status(const rsg::GatewayStatus& sample, const fdds::SampleInfo& info) {
     if (channels_.status == 0) return;
     ++statuses;
-    add(channels_.status, serializer_.serialize(sample), info);
+    add(channels_.status, true, serializer_.serialize(sample), info);
   }
 
-  /// Writes the batch in log time order. Each reader's samples come in the order DDS delivers them and
-  /// the status reader's are taken after the state reader's, so a batch is sorted first; a sample
-  /// stamped before one already written (taken a batch late, or a reliable reader's repaired sample,
-  /// delivered in sequence order after later ones) is logged at the latest log time written, since
-  /// MCAP readers expect log times never to go back (`mcap doctor` warns about every one that does).
-  void write_batch() {
-    std::stable_sort(batch_.begin(), batch_.end(),
-                     [](const Pending& a, const Pending& b) { return a.log_time < b.log_time; });
-    for (const Pending& pending : batch_) {
-      std::uint64_t log_time = pending.log_time;
-      if (log_time < last_log_time_) {
-        log_time = last_log_time_;
-        ++raised;
-      }
-      last_log_time_ = log_time;
-      write(pending.channel, pending.sequence, log_time, pending.publish_time,
-            std::span<const std::uint8_t>(batch_bytes_).subspan(pending.offset, pending.size));
-    }
-    batch_.clear();
-    batch_bytes_.clear();
+  /// Writes what is due at `now` in publication order. A sample placed after one received later is
+  /// logged at the latest log time written, since MCAP readers expect log times never to go back
+  /// (`mcap doctor` warns about every one that does).
+  void write_due(std::uint64_t now) {
+    order_.release(now, [this](const rsg::app::PublicationOrder::Sample& sample) { write(sample); });
   }
   void tick() {
     if (writer_) writer_->finish_chunk_if_older(now_ns());
+    if (options_.max_age_s > 0) apply_retention();
   }
 
   /// After a WriteError: the writer ended the file as well as it could; count what it holds.
@@ -108,23 +109,34 @@ class Recording {
     writer_.reset();
   }
 
-  /// Finishes the current file. Throws mcap::WriteError.
+  /// Writes every sample still held and finishes the current file. Throws mcap::WriteError.
   void close() {
-    write_batch();
-    if (writer_) finish_file();
+    order_.release_all([this](const rsg::app::PublicationOrder::Sample& sample) { write(sample); });
+    if (writer_) finish_file(true);
   }
 
-  std::uint64_t states = 0, statuses = 0;                                                    // received
+  rsg::app::PublicationOrder::Counts state_counts() const { return order_.counts(channels_.robot_state); }
+
+  std::uint64_t states = 0, statuses = 0;  // received
+  std::uint64_t states_written = 0;
   std::uint64_t messages = 0, chunks = 0, uncompressed = 0, compressed = 0, file_bytes = 0;  // written
   std::uint64_t syncs = 0, sync_ns = 0;                                                      // --fsync
-  std::uint64_t raised = 0;  // log times raised to the latest one written (write_batch)
+  std::uint64_t raised = 0;  // log times raised to the latest one written
   std::size_t files = 0;
+  std::size_t removed = 0;  // by retention
 
  private:
-  fs::path next_path() const {
+  struct Finished {
+    fs::path path;
+    std::uint64_t bytes;
+    std::chrono::steady_clock::time_point finished;
+  };
+
+  fs::path next_path() const { return next_path_of(files); }
+  fs::path next_path_of(std::size_t index) const {
     if (split_bytes_ == 0) return options_.out;
     fs::path path = options_.out;
-    path.replace_filename(options_.out.stem().string() + "_" + std::to_string(files) +
+    path.replace_filename(options_.out.stem().string() + "_" + std::to_string(index) +
                           options_.out.extension().string());
     return path;
   }
@@ -140,10 +152,49 @@ class Recording {
     if (split_bytes_ != 0) spdlog::info("writing {}", path.string());
   }
 
-  void finish_file() {
+  /// `last`: no file follows (the recording ends), so retention keeps no room for one.
+  void finish_file(bool last) {
     writer_->close();
     add_totals();
+    if (split_bytes_ != 0)
+      finished_.push_back(
+          {next_path_of(files - 1), writer_->totals().file_bytes, std::chrono::steady_clock::now()});
     writer_.reset();
+    apply_retention(last);
+  }
+
+  /// --max-files, --max-size, --max-age: removes the oldest finished files until the rest (and the
+  /// file being written, or the next one) are within every limit. Finished files only: a file
+  /// being written is never removed.
+  void apply_retention(bool last = false) {
+    const auto now = std::chrono::steady_clock::now();
+    std::uint64_t bytes = 0;
+    for (const Finished& file : finished_) bytes += file.bytes;
+    // Room for the next file: what is being written, or at least one --split-size.
+    const std::uint64_t next_bytes =
+        last ? 0 : std::max(split_bytes_, writer_ ? writer_->totals().file_bytes : 0);
+    const std::size_t next_files = last ? 0 : 1;
+    const auto max_bytes = static_cast<std::uint64_t>(options_.max_mb * 1e6);
+    const auto max_age = std::chrono::duration<double>(options_.max_age_s);
+    while (!finished_.empty()) {
+      const Finished& oldest = finished_.front();
+      const char* why = nullptr;
+      if (options_.max_files != 0 && finished_.size() + next_files > options_.max_files)
+        why = "--max-files";
+      else if (max_bytes != 0 && bytes + next_bytes > max_bytes)
+        why = "--max-size";
+      else if (options_.max_age_s > 0 && now - oldest.finished > max_age)
+        why = "--max-age";
+      if (why == nullptr) return;
+      std::error_code error;
+      if (!fs::remove(oldest.path, error) && error)
+        spdlog::warn("cannot remove {} ({}): {}", oldest.path.string(), why, error.message());
+      else
+        spdlog::info("removed {} ({})", oldest.path.string(), why);
+      bytes -= oldest.bytes;
+      ++removed;
+      finished_.pop_front();
+    }
   }
 
   void add_totals() {
@@ -157,32 +208,41 @@ class Recording {
     sync_ns += totals.sync_ns;
   }
 
-  struct Pending {
-    std::uint16_t channel;
-    std::uint32_t sequence;
-    std::uint64_t log_time, publish_time;
-    std::size_t offset, size;  // in batch_bytes_
-  };
-
-  void add(std::uint16_t channel, std::span<const std::uint8_t> payload, const fdds::SampleInfo& info) {
-    // Log time: when DDS received the sample (not when a batch was taken); publish time: when the
+  void add(std::uint16_t channel, bool contiguous, std::span<const std::uint8_t> payload,
+           const fdds::SampleInfo& info) {
+    // Log time: when DDS received the sample (not when it was taken); publish time: when the
     // gateway wrote it, the robot's frame timing that rsg_replay reproduces.
     const std::int64_t reception_time = info.reception_timestamp.to_ns();
     const std::uint64_t log_time = reception_time > 0 ? static_cast<std::uint64_t>(reception_time) : now_ns();
     const std::int64_t source_time = info.source_timestamp.to_ns();
     const std::uint64_t publish_time = source_time > 0 ? static_cast<std::uint64_t>(source_time) : log_time;
-    // The DDS sequence number (its low 32 bits) lets a reader of the file see gaps.
-    batch_.push_back({channel, info.sample_identity.sequence_number().low, log_time, publish_time,
-                      batch_bytes_.size(), payload.size()});
-    batch_bytes_.insert(batch_bytes_.end(), payload.begin(), payload.end());
+    const auto& guid = info.sample_identity.writer_guid();
+    rsg::app::PublicationOrder::WriterId writer{};
+    std::copy(std::begin(guid.guidPrefix.value), std::end(guid.guidPrefix.value), writer.begin());
+    std::copy(std::begin(guid.entityId.value), std::end(guid.entityId.value),
+              writer.begin() + sizeof(guid.guidPrefix.value));
+    order_.add(writer, contiguous, payload,
+               {.channel = channel,
+                .sequence = static_cast<std::uint64_t>(info.sample_identity.sequence_number().to64long()),
+                .log_time = log_time,
+                .publish_time = publish_time,
+                .payload = {}});
   }
 
-  void write(std::uint16_t channel, std::uint32_t sequence, std::uint64_t log_time,
-             std::uint64_t publish_time, std::span<const std::uint8_t> payload) {
+  void write(const rsg::app::PublicationOrder::Sample& sample) {
+    std::uint64_t log_time = sample.log_time;
+    if (log_time < last_log_time_) {
+      log_time = last_log_time_;
+      ++raised;
+    }
+    last_log_time_ = log_time;
+    if (sample.channel == channels_.robot_state) ++states_written;
     // After a split the next file is opened by the next message, so that none is left empty.
     if (!writer_) open();
-    writer_->write(channel, sequence, log_time, publish_time, payload);
-    if (split_bytes_ != 0 && writer_->totals().file_bytes >= split_bytes_) finish_file();
+    // The DDS sequence number (its low 32 bits: MCAP's field) lets a reader of the file see gaps.
+    writer_->write(sample.channel, static_cast<std::uint32_t>(sample.sequence), log_time, sample.publish_time,
+                   sample.payload);
+    if (split_bytes_ != 0 && writer_->totals().file_bytes >= split_bytes_) finish_file(false);
   }
 
   const Options& options_;
@@ -191,26 +251,9 @@ class Recording {
   std::optional<rsg::mcap::Writer> writer_;
   rsg::app::Channels channels_;
   rsg::app::CdrSerializer serializer_;
-  std::vector<Pending> batch_;
-  std::vector<std::uint8_t> batch_bytes_;
+  rsg::app::PublicationOrder order_;
   std::uint64_t last_log_time_ = 0;
-};
-
-/// Counts samples the recorder never got: gaps in each writer's sequence numbers (meaningful
-/// without a view, whose filter leaves gaps on purpose) and what DDS reports as lost.
-class LossCounter {
- public:
-  void add(const fdds::SampleInfo& info) {
-    const auto& identity = info.sample_identity;
-    const std::uint64_t sequence = identity.sequence_number().to64long();
-    auto [last, inserted] = last_.try_emplace(identity.writer_guid(), sequence);
-    if (!inserted && sequence > last->second + 1) gaps += sequence - last->second - 1;
-    last->second = sequence;
-  }
-  std::uint64_t gaps = 0;
-
- private:
-  std::map<rsg::dds::rtps::GUID_t, std::uint64_t> last_;
+  std::deque<Finished> finished_;  // with --split-size, oldest first, not yet removed
 };
 
 void add_options(CLI::App& app, Options& options) {
@@ -227,9 +270,27 @@ void add_options(CLI::App& app, Options& options) {
          "Do not record: write what FILE (a recording whose recorder was killed) holds up to its last "
          "whole chunk to --out as a finished, indexed file, and exit")
       ->check(CLI::ExistingFile);
-  app.add_option("--split-size", options.split_mb,
-                 "Start a new file when one reaches this many MB: FILE_0.mcap, FILE_1.mcap, ...")
-      ->check(CLI::NonNegativeNumber);
+  auto* split =
+      app.add_option("--split-size", options.split_mb,
+                     "Start a new file when one reaches this many MB: FILE_0.mcap, FILE_1.mcap, ...")
+          ->check(CLI::NonNegativeNumber);
+  // Retention, as rosbag2 users know it from storage limits: a recorder left running keeps the
+  // newest files within the limits instead of filling the disk.
+  app.add_option(
+         "--max-files", options.max_files,
+         "With --split-size: keep at most this many files (the one being written included), removing the "
+         "oldest")
+      ->check(CLI::Range(std::size_t{2}, std::numeric_limits<std::size_t>::max()))
+      ->needs(split);
+  app.add_option("--max-size", options.max_mb,
+                 "With --split-size: keep the files within about this many MB together, removing the oldest "
+                 "(room is kept for one more --split-size file)")
+      ->check(CLI::PositiveNumber)
+      ->needs(split);
+  app.add_option("--max-age", options.max_age_s,
+                 "With --split-size: remove a finished file this many seconds after it was finished")
+      ->check(CLI::PositiveNumber)
+      ->needs(split);
   app.add_option("--chunk-size", options.chunk_bytes,
                  "Finish a chunk when its records reach this many bytes before compression (or span 1 s): "
                  "smaller chunks lose less to a crash and seek finer, compress worse")
@@ -274,43 +335,52 @@ int run(const Options& options, rsg::app::Profile profile) {
 
   const auto start = std::chrono::steady_clock::now();
   const auto duration = std::chrono::duration<double>(options.duration_s);
-  LossCounter loss;
   rsg::app::MatchedWriters matched_writers(options.topic, writers, options.domain);
   rsg::RobotState state;
   rsg::GatewayStatus status;
   fdds::SampleInfo info;
   int exit_code = kExitOk;
-  const auto write_what_was_received = [&] {
+  // DDS counts as lost, too, the samples of the writer's history it gave up on while the reader
+  // joined (from before the recording's first sample): only what it counts after that is a loss.
+  std::optional<std::int32_t> lost_before_first;
+  fdds::SampleLostStatus lost;
+  const auto take_what_was_received = [&] {
     while (readers.state().take_next_sample(&state, &info) == rsg::dds::kOk) {
       if (!info.valid_data) continue;
       matched_writers.on_sample();
-      loss.add(info);
       recording.add_state(state, info);
     }
     while (readers.status() != nullptr && readers.status()->take_next_sample(&status, &info) == rsg::dds::kOk)
       if (info.valid_data) recording.add_status(status, info);
-    recording.write_batch();
+  };
+  const auto note_first_written = [&] {
+    if (lost_before_first || recording.states_written == 0) return;
+    readers.state().get_sample_lost_status(lost);
+    lost_before_first = lost.total_count;
   };
   try {
     while (!readers.stop_requested() &&
            (options.duration_s == 0 || std::chrono::steady_clock::now() - start < duration)) {
       readers.wait(kBatchPeriod);
       matched_writers.update(readers.state());
-      write_what_was_received();
+      take_what_was_received();
+      recording.write_due(now_ns());
+      note_first_written();
       recording.tick();
     }
     // A slow disk (--fsync, a busy host) can leave the recorder seconds behind DDS: what the reader
     // history already holds at SIGTERM was received and belongs in the file.
-    write_what_was_received();
+    take_what_was_received();
     recording.close();
+    note_first_written();
   } catch (const rsg::mcap::WriteError& error) {
     spdlog::error("{}", error.what());
     recording.count_failed_file();
     exit_code = kExitFailure;
   }
 
-  fdds::SampleLostStatus lost;
   readers.state().get_sample_lost_status(lost);
+  const auto counts = recording.state_counts();
   const double ratio = recording.compressed == 0 ? 0
                                                  : static_cast<double>(recording.uncompressed) /
                                                        static_cast<double>(recording.compressed);
@@ -318,14 +388,31 @@ int run(const Options& options, rsg::app::Profile profile) {
       "{} messages in {} chunks, {} {}, {} bytes; compression ratio {:g}; received {} states, {} statuses; "
       "dropped {} (sequence gaps), {} (lost in DDS)",
       recording.messages, recording.chunks, recording.files, recording.files == 1 ? "file" : "files",
-      recording.file_bytes, ratio, recording.states, recording.statuses,
-      options.view_profile.empty() ? loss.gaps : 0, lost.total_count);
+      recording.file_bytes, ratio, recording.states, recording.statuses, counts.gaps,
+      lost_before_first ? lost.total_count - *lost_before_first : 0);
+  if (counts.late > 0)
+    summary += fmt::format("; {} of the dropped arrived after a later state was written", counts.late);
+  if (counts.before_start > 0)
+    summary += fmt::format("; {} states from before the first recorded one arrived late, left out",
+                           counts.before_start);
   if (recording.raised > 0)
     summary += fmt::format("; {} log times raised to keep their order", recording.raised);
+  if (recording.removed > 0)
+    summary += fmt::format("; {} oldest {} removed (retention)", recording.removed,
+                           recording.removed == 1 ? "file" : "files");
   if (options.fsync)
     summary +=
         fmt::format("; {} fsyncs in {:g} ms", recording.syncs, static_cast<double>(recording.sync_ns) / 1e6);
   spdlog::info("{}", summary);
+  if (!matched_writers.ever_matched()) {
+    // An empty file and exit 0 would look like a recording of an idle robot.
+    matched_writers.explain_if_unmatched(readers.state());
+    spdlog::error("no writer of '{}' matched in {:.1f} s (see the warnings above): {} holds no state",
+                  options.topic,
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                  options.out.string());
+    return kExitFailure;
+  }
   return exit_code;
 }
 
@@ -337,7 +424,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Records RobotState and GatewayStatus samples into an MCAP file.", "rsg_record"};
   app.footer(
       "Exit status: 0 after --duration or on SIGINT/SIGTERM (the file finished), 1 when the file cannot be "
-      "written (what was recorded stays readable) or DDS fails, 2 usage error. --recover: 0 when FILE read "
+      "written (what was recorded stays readable), DDS fails or no writer of the topic matched, 2 usage "
+      "error. --recover: 0 when FILE read "
       "to "
       "its end or was cut off, 1 when it is damaged inside.");
   Options options;
@@ -358,6 +446,10 @@ int main(int argc, char** argv) {
           "this build has no ros2/rsg_msgs/msg/GatewayStatus.msg, so a --profile ros2 recording leaves "
           "'{}' out",
           options.status_topic);
+    if (options.max_mb > 0 && options.max_mb < 2 * options.split_mb)
+      throw rsg::InputError(
+          fmt::format("--max-size {:g} keeps no finished file of --split-size {:g}: give at least {:g}",
+                      options.max_mb, options.split_mb, 2 * options.split_mb));
     rsg::dds::load_profiles(options.profiles, options.participant_profile);
     return run(options, *profile);
   });

@@ -14,7 +14,9 @@
 //        [--groups G]    only frames carrying all groups of the bit mask G (a recorder on a view)
 //        [--msg-dir DIR] with --profile ros2: each schema rsg_msgs/msg/X must be DIR/X.msg
 //
-// Prints one JSON line describing what it read; exits 1 with the reason on the first mismatch.
+// Prints one JSON line describing what it read (first_sequence: the first state's DDS sequence
+// number; sequence_breaks: states whose sequence number is not one more than the one before's);
+// exits 1 with the reason on the first mismatch.
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
 import { crc32 } from "@foxglove/crc";
 import { parseIDL } from "@foxglove/omgidl-parser";
@@ -169,5 +171,9 @@ const publishSpan = states.reduce((span, message) => {
   const offset = message.publishTime - states[0].publishTime;
   return offset > span ? offset : span;
 }, 0n);
+// The states in publication order: each DDS sequence number one more than the one before.
+let sequenceBreaks = 0;
+for (let i = 1; i < states.length; i++) if (states[i].sequence !== states[i - 1].sequence + 1) sequenceBreaks++;
 console.log(JSON.stringify({ ...summary, messages: messages.length, states: states.length, statuses: statuses.length,
-                             publish_span_ns: Number(publishSpan) }));
+                             publish_span_ns: Number(publishSpan), first_sequence: states.length ? states[0].sequence : 0,
+                             sequence_breaks: sequenceBreaks }));

@@ -396,8 +396,112 @@ def drain_on_sigterm(h):
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
 
 
+def cpu_hogs(h, count, seconds):
+    """`count` processes that spin for `seconds` (then exit by themselves): a busy host."""
+    spin = f"import time\nend = time.monotonic() + {seconds}\nwhile time.monotonic() < end: pass"
+    return [h.start(f"hog{i}", [sys.executable, "-c", spin]) for i in range(count)]
+
+
+def mid_stream_under_load(h):
+    """A recorder that joins a running 1 kHz stream on a host kept busy by CPU hogs writes the states
+    in publication order from its first one on (each DDS sequence number one more than the one
+    before, the values those frames carried), says it dropped and lost nothing, and its file,
+    replayed into a second gateway, gives that gateway 0 lost, duplicated and reordered frames: the
+    counters of the clean original stream. (The reader gets the writer's history after the first
+    live samples as it joins; written in arrival order, the file jumped back.)"""
+    port = free_udp_port()
+    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000")
+    count = 9000
+    record = h.dir / "sim.record.jsonl"
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", str(count),
+                          "--record", str(record)])
+    hogs = cpu_hogs(h, 3, 8)
+    wait_for_stats(stats, lambda s: s["frames_published"] >= 1000, "the stream to run")
+    out = h.dir / "run.mcap"
+    rec = recorder(h, "record", out, "--duration", "4", "--chunk-size", "65536")
+    check(h.wait("record", rec, 30) == 0, f"rsg_record did not exit 0 after --duration: {stderr_of(h, 'record')}")
+    err = stderr_of(h, "record")
+    print(f"[{h.name}] {err.strip()}", flush=True)
+    check("dropped 0 (sequence gaps), 0 (lost in DDS)" in err, f"the recorder lost states: {err}")
+    check(h.wait("sim", sim, 30) == 0, "rsg_sim failed")
+    for hog in hogs:
+        hog.wait(timeout=30)
+    final = wait_for_stats(stats, lambda s: s["frames_published"] >= count, "the gateway to publish every frame")
+    check((final["lost"], final["duplicated"], final["reordered"]) == (0, 0, 0), f"the source was not clean: {final}")
+    seen = node_check(h, out)
+    check(seen["states"] >= 1000 and seen["sequence_breaks"] == 0,
+          f"the file's states are not in publication order from the first on: {seen}")
+    # The gateway's writer numbers its samples from 1, one per frame: sequence n is frame n - 1.
+    node_check(h, out, "--frames", record, "--skip", seen["first_sequence"] - 1, "--prefix")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+    port2 = free_udp_port()
+    gateway2, stats2 = h.gateway("gateway2", "--listen", f"127.0.0.1:{port2}", "--topic", "replayed",
+                                 "--status-topic", "replayed_status", "--expected-rate", "1000")
+    status = h.run("replay", [h.binary("rsg_replay"), str(out), "--to", f"127.0.0.1:{port2}"])
+    check(status == 0, f"rsg_replay exited {status}: {stderr_of(h, 'replay')}")
+    replayed = wait_for_stats(stats2, lambda s: s["frames_received"] >= seen["states"], "the replayed frames")
+    time.sleep(1.2)  # the next stats period: counters settled
+    replayed = wait_for_stats(stats2, lambda s: True, "the second gateway's stats")
+    print(f"[{h.name}] replayed {seen['states']} states: the second gateway received {replayed['frames_received']}, "
+          f"lost {replayed['lost']}, duplicated {replayed['duplicated']}, reordered {replayed['reordered']}", flush=True)
+    check((replayed["frames_received"], replayed["lost"], replayed["duplicated"], replayed["reordered"])
+          == (seen["states"], 0, 0, 0), f"the replay is not the clean stream it recorded: {replayed}")
+    check(h.stop("gateway2", gateway2) == 0, "the second gateway did not exit 0")
+
+
+def no_writer(h):
+    """A recorder that never matches a writer (here: the wrong partition) exits 1 and says why and
+    what discovery shows instead, rather than exit 0 with an empty file."""
+    port = free_udp_port()
+    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--partition", "robot1")
+    out = h.dir / "run.mcap"
+    rec = recorder(h, "record", out, "--partition", "robot2", "--duration", "4")
+    status = h.wait("record", rec, 30)
+    err = stderr_of(h, "record")
+    check(status == 1, f"rsg_record exited {status} without a writer: {err}")
+    check("no writer of 'robot_state' matched" in err and "holds no state" in err and "robot1" in err, err)
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+def retention(h):
+    """--split-size with --max-files keeps the newest files, the rest removed oldest first, and what
+    they hold is the end of the stream, exact; with --max-size the files together stay within the
+    limit (and one file's overshoot: a file ends at the first chunk boundary after its size)."""
+    port, gateway, stats, rec, out = gateway_with_recorder(h, "--split-size", "0.1", "--max-files", "3",
+                                                           "--chunk-size", "65536")
+    sized = h.dir / "sized.mcap"
+    rec2 = recorder(h, "record_sized", sized, "--split-size", "0.1", "--max-size", "0.3", "--chunk-size", "65536",
+                    "--status-topic", "")
+    wait_matched(h, stats, ["record", "record_sized"], "rsg_record")
+    count = 2000
+    record = run_sim(h, port, count, 1000)
+    wait_for_stats(stats, lambda s: s["frames_published"] >= count, "the gateway to publish every frame")
+    time.sleep(1.5)
+    check(h.stop("record", rec) == 0 and h.stop("record_sized", rec2) == 0, "a recorder did not exit 0")
+    files = sorted(h.dir.glob("run_*.mcap"), key=lambda path: int(path.stem.split("_")[1]))
+    indexes = [int(path.stem.split("_")[1]) for path in files]
+    err = stderr_of(h, "record")
+    check(len(files) == 3 and indexes == list(range(indexes[0], indexes[0] + 3)) and indexes[0] >= 3,
+          f"--max-files 3 left {[path.name for path in files]}: {err}")
+    check(f"removed {h.dir / 'run_0.mcap'} (--max-files)" in err and f"; {indexes[0]} oldest files removed" in err, err)
+    kept = [node_check(h, path)["states"] for path in files]
+    skip = count - sum(kept)
+    for path, states in zip(files, kept):
+        node_check(h, path, "--frames", record, "--skip", skip)
+        skip += states
+    sized_files = list(h.dir.glob("sized_*.mcap"))
+    total = sum(path.stat().st_size for path in sized_files)
+    print(f"[{h.name}] --max-files 3: {[path.name for path in files]}; --max-size 0.3: {len(sized_files)} files, "
+          f"{total} bytes", flush=True)
+    check(len(sized_files) >= 2 and total <= 300_000 + 100_000, f"--max-size 0.3 left {len(sized_files)} files of "
+          f"{total} bytes: {stderr_of(h, 'record_sized')}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
 CASES = {f.__name__: f for f in (reference_reader, sigkill, write_errors, replay_roundtrip, split_and_view, duration,
-                                 ros2_profile, chunk_size_fsync, drain_on_sigterm)}
+                                 ros2_profile, chunk_size_fsync, drain_on_sigterm, mid_stream_under_load, no_writer,
+                                 retention)}
 
 if __name__ == "__main__":
     sys.exit(main(f"record_{CASE}", CASES[CASE]))
