@@ -411,6 +411,7 @@ def mid_stream_under_load(h):
     live samples as it joins; written in arrival order, the file jumped back.)"""
     port = free_udp_port()
     gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000")
+    wait_for_stats(stats, lambda s: True, "the gateway to start", timeout_s=60)
     count = 9000
     record = h.dir / "sim.record.jsonl"
     sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", str(count),
@@ -438,6 +439,7 @@ def mid_stream_under_load(h):
     port2 = free_udp_port()
     gateway2, stats2 = h.gateway("gateway2", "--listen", f"127.0.0.1:{port2}", "--topic", "replayed",
                                  "--status-topic", "replayed_status", "--expected-rate", "1000")
+    wait_for_stats(stats2, lambda s: True, "the second gateway to start", timeout_s=60)  # listening
     status = h.run("replay", [h.binary("rsg_replay"), str(out), "--to", f"127.0.0.1:{port2}"])
     check(status == 0, f"rsg_replay exited {status}: {stderr_of(h, 'replay')}")
     replayed = wait_for_stats(stats2, lambda s: s["frames_received"] >= seen["states"], "the replayed frames")
