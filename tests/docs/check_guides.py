@@ -64,7 +64,10 @@ def translation_unit(code):
 
 
 def check_snippets(root, cxx, flags_file):
-    flags = [line for line in Path(flags_file).read_text().splitlines() if line.strip()]
+    # The compiler's own directories stay out: -I/usr/include ahead of them breaks libstdc++'s
+    # #include_next <stdlib.h> (CMake leaves them out of a compile line itself).
+    flags = list(dict.fromkeys(line.strip() for line in Path(flags_file).read_text().splitlines()
+                               if line.strip() and line.strip() != "-I/usr/include"))
     failures, compiled = [], 0
     with tempfile.TemporaryDirectory(prefix="rsg_snippets_") as tmp:
         for guide in guides(root):
