@@ -442,11 +442,12 @@ def mid_stream_under_load(h):
     wait_for_stats(stats2, lambda s: True, "the second gateway to start", timeout_s=60)  # listening
     status = h.run("replay", [h.binary("rsg_replay"), str(out), "--to", f"127.0.0.1:{port2}"])
     check(status == 0, f"rsg_replay exited {status}: {stderr_of(h, 'replay')}")
-    replayed = wait_for_stats(stats2, lambda s: s["frames_received"] >= seen["states"], "the replayed frames")
+    wait_for_stats(stats2, lambda s: s["frames_received"] >= seen["states"], "the replayed frames")
     time.sleep(1.2)  # the next stats period: counters settled
     replayed = wait_for_stats(stats2, lambda s: True, "the second gateway's stats")
     print(f"[{h.name}] replayed {seen['states']} states: the second gateway received {replayed['frames_received']}, "
-          f"lost {replayed['lost']}, duplicated {replayed['duplicated']}, reordered {replayed['reordered']}", flush=True)
+          f"lost {replayed['lost']}, duplicated {replayed['duplicated']}, reordered {replayed['reordered']}",
+          flush=True)
     check((replayed["frames_received"], replayed["lost"], replayed["duplicated"], replayed["reordered"])
           == (seen["states"], 0, 0, 0), f"the replay is not the clean stream it recorded: {replayed}")
     check(h.stop("gateway2", gateway2) == 0, "the second gateway did not exit 0")
