@@ -470,18 +470,26 @@ def no_writer(h):
 def retention(h):
     """--split-size with --max-files keeps the newest files, the rest removed oldest first, and what
     they hold is the end of the stream, exact; with --max-size the files together stay within the
-    limit (and one file's overshoot: a file ends at the first chunk boundary after its size)."""
+    limit (and one file's overshoot: a file ends at the first chunk boundary after its size); with
+    --max-age a file finished longer ago than that is removed while the recorder runs."""
     port, gateway, stats, rec, out = gateway_with_recorder(h, "--split-size", "0.1", "--max-files", "3",
                                                            "--chunk-size", "65536")
     sized = h.dir / "sized.mcap"
     rec2 = recorder(h, "record_sized", sized, "--split-size", "0.1", "--max-size", "0.3", "--chunk-size", "65536",
                     "--status-topic", "")
-    wait_matched(h, stats, ["record", "record_sized"], "rsg_record")
+    aged = h.dir / "aged.mcap"
+    rec3 = recorder(h, "record_aged", aged, "--split-size", "0.1", "--max-age", "1", "--chunk-size", "65536",
+                    "--status-topic", "")
+    wait_matched(h, stats, ["record", "record_sized", "record_aged"], "rsg_record")
     count = 2000
     record = run_sim(h, port, count, 1000)
     wait_for_stats(stats, lambda s: s["frames_published"] >= count, "the gateway to publish every frame")
     time.sleep(1.5)
-    check(h.stop("record", rec) == 0 and h.stop("record_sized", rec2) == 0, "a recorder did not exit 0")
+    check(h.stop("record", rec) == 0 and h.stop("record_sized", rec2) == 0 and h.stop("record_aged", rec3) == 0,
+          "a recorder did not exit 0")
+    # The first file was finished early in the stream, well over a second before the stop.
+    check(not (h.dir / "aged_0.mcap").exists() and "aged_0.mcap (--max-age)" in stderr_of(h, "record_aged"),
+          f"--max-age 1 kept aged_0.mcap: {stderr_of(h, 'record_aged')}")
     files = sorted(h.dir.glob("run_*.mcap"), key=lambda path: int(path.stem.split("_")[1]))
     indexes = [int(path.stem.split("_")[1]) for path in files]
     err = stderr_of(h, "record")
