@@ -166,13 +166,20 @@ format:
 	git ls-files '*.cpp' '*.hpp' '*.h' '*.c' | xargs clang-format -i
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) build-demo build-fdds3 build-time $(PKG_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) build-demo build-fdds3 build-fdds214 build-time $(PKG_BUILD)
 
 # Fast DDS 3 (Debian 13's 3.1.2) in a cached trixie chroot, and across versions with $(BUILD)'s
 # 2.9.1 on the host (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/.
 .PHONY: test-fastdds3 bench-fastdds3
 test-fastdds3: build-tests
 	JOBS=$(JOBS) tests/fastdds3/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds3.log
+
+# Fast DDS 2.14.5 (ROS 2 Jazzy's LTS, its PyPI wheels in $(DEPS_DIR)/fastdds214) found on
+# CMAKE_PREFIX_PATH, and across versions with $(BUILD)'s 2.9.1 (tests/fastdds214/run.sh,
+# docs/fastdds-versions.md). Its own tree, build-fdds214/.
+.PHONY: test-fastdds214
+test-fastdds214: build
+	JOBS=$(JOBS) DEPS_DIR=$(DEPS_DIR) tests/fastdds214/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds214.log
 
 # make bench's e2e suite on 2.9 (host) and 3.x (chroot) back to back, side by side (docs/benchmarks/fastdds3/).
 bench-fastdds3: build-tests
