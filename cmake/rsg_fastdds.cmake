@@ -30,8 +30,6 @@ foreach(_rsg_lib IN LISTS _rsg_fastrtps_libs)
 endforeach()
 if(RSG_FASTRTPS_TINYXML2)
   set_target_properties(fastrtps PROPERTIES INTERFACE_LINK_LIBRARIES "${_rsg_fastrtps_fixed}")
-endif()
-if(RSG_FASTDDS_TINYXML2)
   # The wheel's libfastrtps.so finds the libraries it carries (OpenSSL 1.1.1k, TinyXML-2) through an
   # RPATH that points nowhere once pip has installed it (lib/ is not beside ros_fastrtps.libs/): a
   # sourced ROS 2 environment's LD_LIBRARY_PATH names them. rsg's programs carry the directory as

@@ -575,7 +575,7 @@ def gen_typeobject_source(name, idl, structs):
     out = [HEADER.format(idl=idl), f'#include "{name}TypeObject.h"\n\n']
     out.append("#include <fastcdr/Cdr.h>\n#include <fastcdr/CdrSizeCalculator.hpp>\n#include <fastcdr/FastBuffer.h>\n"
                "#include <fastrtps/rtps/common/SerializedPayload.h>\n"
-               "#include <fastrtps/types/TypeObjectFactory.h>\n#include <fastrtps/utils/md5.h>\n\n")
+               "#include <fastrtps/types/TypeObjectFactory.h>\n#include <fastrtps/utils/md5.h>\n\n#include <type_traits>\n\n")
     out.append("""namespace {
 
 using namespace eprosima::fastrtps::types;
@@ -599,6 +599,23 @@ void clear_flags(StructTypeFlag& flags) {
   flags.IS_MUTABLE(false);
   flags.IS_NESTED(false);
   flags.IS_AUTOID_HASH(false);
+}
+
+/// One member, as fastddsgen 2.3 describes it: its name in a complete object, the first 4 bytes of
+/// the name's MD5 in a minimal one.
+template <class Member, class Type>
+void add_member(Type& type, MemberId id, const TypeIdentifier& member_type, const char* name) {
+  Member member;
+  member.common().member_id(id);
+  clear_flags(member.common());
+  member.common().member_type_id(member_type);
+  if constexpr (std::is_same_v<Member, CompleteStructMember>) {
+    member.detail().name(name);
+  } else {
+    MD5 hash(name);
+    for (int i = 0; i < 4; ++i) member.detail().name_hash()[i] = hash.digest[i];
+  }
+  type.member_seq().emplace_back(member);
 }
 
 /// The equivalence hash: the first 14 bytes of the MD5 of the object's little-endian XCDR1 bytes
@@ -648,15 +665,7 @@ const eprosima::fastrtps::types::TypeObject* Get{s.name}Object(bool complete) {{
     clear_flags(type.struct_flags());
 """)
         for index, member in enumerate(s.members):
-            out.append(f"""    {{
-      CompleteStructMember member;
-      member.common().member_id({index});
-      clear_flags(member.common());
-      member.common().member_type_id({type_identifier_expr(member, True)});
-      member.detail().name("{member.name}");
-      type.member_seq().emplace_back(member);
-    }}
-""")
+            out.append(f'    add_member<CompleteStructMember>(type, {index}, {type_identifier_expr(member, True)}, "{member.name}");\n')
         out.append(f"""    type.header().detail().type_name("{s.name}");
     identifier._d(EK_COMPLETE);
   }} else {{
@@ -666,16 +675,7 @@ const eprosima::fastrtps::types::TypeObject* Get{s.name}Object(bool complete) {{
     clear_flags(type.struct_flags());
 """)
         for index, member in enumerate(s.members):
-            out.append(f"""    {{
-      MinimalStructMember member;
-      member.common().member_id({index});
-      clear_flags(member.common());
-      member.common().member_type_id({type_identifier_expr(member, False)});
-      MD5 name("{member.name}");
-      for (int i = 0; i < 4; ++i) member.detail().name_hash()[i] = name.digest[i];
-      type.member_seq().emplace_back(member);
-    }}
-""")
+            out.append(f'    add_member<MinimalStructMember>(type, {index}, {type_identifier_expr(member, False)}, "{member.name}");\n')
         out.append(f"""    identifier._d(EK_MINIMAL);
   }}
   hash(object, identifier);

@@ -33,25 +33,8 @@ targets=(unit_tests rsg_gateway rsg_sim rsg_echo rsg_frame rsg_status_probe rsg_
          rsg_example_embedded_controller rsg_ros2_standard_echo rsg_generate_msg rsg_record rsg_replay
          rsg_embedded_gateway rsg_type_dump)
 
-passed=0
-failed=0
-count_ctest() {  # ctest's "97% tests passed, 3 tests failed out of 100"
-  local bad total
-  if read -r bad total < <(sed -nE 's/.* tests passed, ([0-9]+) tests? failed out of ([0-9]+).*/\1 \2/p' "$1" | tail -n 1); then
-    passed=$((passed + total - bad)); failed=$((failed + bad))
-  else
-    echo "$1: no ctest summary" >&2; failed=$((failed + 1))
-  fi
-}
-check() {  # NAME COMMAND...: one test of this script, its output in $logs/NAME.log
-  local name=$1; shift
-  local start=$SECONDS
-  if "$@" > "$logs/$name.log" 2>&1; then
-    passed=$((passed + 1)); echo "fastdds214.$name: passed ($((SECONDS - start)) s)"
-  else
-    failed=$((failed + 1)); echo "fastdds214.$name: FAILED ($((SECONDS - start)) s)"; tail -n 40 "$logs/$name.log"
-  fi
-}
+suite=fastdds214
+source tests/support/suite_counts.sh
 
 start=$SECONDS
 # 1. The wheels: Debian's Python 3.11, which they are built for (cp311).

@@ -53,7 +53,7 @@ void identifiers(const char* name) {
       std::printf("none\n");
       continue;
     }
-    for (const auto byte : id->equivalence_hash()) std::printf("%02x", byte);
+    for (int i = 0; i < 14; ++i) std::printf("%02x", id->equivalence_hash()[i]);
     std::printf("\n");
   }
 }

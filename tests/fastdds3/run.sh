@@ -39,25 +39,8 @@ targets=(unit_tests rsg_gateway rsg_sim rsg_echo rsg_frame rsg_status_probe rsg_
          rsg_cyclone_echo rsg_cyclone_publish rsg_example_embedded_controller rsg_ros2_standard_echo
          rsg_generate_msg rsg_record rsg_replay rsg_embedded_gateway)
 
-passed=0
-failed=0
-count_ctest() {  # ctest's "97% tests passed, 3 tests failed out of 100"
-  local bad total
-  if read -r bad total < <(sed -nE 's/.* tests passed, ([0-9]+) tests? failed out of ([0-9]+).*/\1 \2/p' "$1" | tail -n 1); then
-    passed=$((passed + total - bad)); failed=$((failed + bad))
-  else
-    echo "$1: no ctest summary" >&2; failed=$((failed + 1))
-  fi
-}
-check() {  # NAME COMMAND...: one cross-version test, its output in $logs/NAME.log
-  local name=$1; shift
-  local start=$SECONDS
-  if "$@" > "$logs/$name.log" 2>&1; then
-    passed=$((passed + 1)); echo "cross.$name: passed ($((SECONDS - start)) s)"
-  else
-    failed=$((failed + 1)); echo "cross.$name: FAILED ($((SECONDS - start)) s)"; tail -n 40 "$logs/$name.log"
-  fi
-}
+suite=cross
+source tests/support/suite_counts.sh
 
 start=$SECONDS
 $chroot setup || exit 1

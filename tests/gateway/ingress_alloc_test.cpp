@@ -196,6 +196,10 @@ class IngressAllocation : public ::testing::Test {
     // Not link_up: it is down after 10 ms without a frame, and a loaded host can pause this thread
     // that long after the last burst (it failed so once). link_monitor_test.cpp covers the link.
 
+    // A reliable reader delivers in order: one that missed a datagram of the last burst holds what
+    // came after it until the writer's next heartbeat repairs the gap (seen on Fast DDS 2.14), so
+    // the first sample may come a heartbeat period after the last write.
+    EXPECT_TRUE(reader->wait_for_unread_message(rsg::dds::Duration(5, 0))) << "nothing reached the reader";
     RobotState sample;
     fdds::SampleInfo info;
     EXPECT_EQ(reader->take_next_sample(&sample, &info), rsg::dds::kOk) << "nothing reached the reader";

@@ -317,8 +317,19 @@ inline void disable_intraprocess_delivery() {
   eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
 }
 
-/// Fast DDS 2 reads a plain type in place whatever the reader's representations.
-inline void read_plain_samples_in_place(eprosima::fastdds::dds::DataReaderQos& /*qos*/) {}
+/// Fast DDS 2.9 reads a plain type in place whatever the reader's representations. 2.14 (since
+/// eProsima/Fast-DDS#4681, in a 2.14 patch release) does what 3.x does (see the 3.x version above):
+/// an empty list counts as XCDR1 and XCDR2 there, so the reader lists XCDR1, where 2.x keeps a
+/// reader's representations (type_consistency()), which matches the same writers
+/// (EDP::checkDataRepresentationQos).
+inline void read_plain_samples_in_place(eprosima::fastdds::dds::DataReaderQos& qos) {
+#if FASTRTPS_VERSION_MINOR >= 14
+  auto& representations = qos.type_consistency().representation.m_value;
+  if (representations.empty()) representations.push_back(eprosima::fastdds::dds::XCDR_DATA_REPRESENTATION);
+#else
+  (void)qos;
+#endif
+}
 
 /// Fast DDS 2 finds server number `id` by its default GUID prefix.
 inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& qos, unsigned id,
