@@ -6,7 +6,7 @@
 #   tests/fastdds214/run.sh [HOST_BUILD]     HOST_BUILD: the host's 2.9 build tree (default build)
 #
 # 1. installs the wheels (tests/fastdds214/requirements.txt, pinned with hashes) into
-#    $DEPS_DIR/fastdds214, once per requirements file;
+#    $DEPS_DIR/fastdds214 (or $RSG_FASTDDS214_PREFIX), once per requirements file;
 # 2. configures and builds $RSG_FASTDDS214_BUILD (default build-fdds214) with that environment first
 #    on CMAKE_PREFIX_PATH and LD_LIBRARY_PATH, as Jazzy's setup.bash puts it: the targets of the
 #    tests below only;
@@ -21,7 +21,7 @@ checkout=$PWD
 host_build=${1:-build}
 build=${RSG_FASTDDS214_BUILD:-build-fdds214}
 deps=${DEPS_DIR:-$checkout/.deps}
-venv=$deps/fastdds214
+venv=${RSG_FASTDDS214_PREFIX:-$deps/fastdds214}  # where the wheels go
 requirements=tests/fastdds214/requirements.txt
 jobs=${JOBS:-$(nproc)}
 logs=$build/test-fastdds214
@@ -72,7 +72,10 @@ echo "test-fastdds214: built in $((SECONDS - start)) s"
 (cd "$build" && ctest --output-on-failure -j "$((jobs + 1))" -L unit -E '^packaging') > "$logs/unit.log" 2>&1
 tail -n 3 "$logs/unit.log"
 count_ctest "$logs/unit.log"
-(cd "$build" && ctest --output-on-failure -j "$((jobs + 1))" -R "^($processes)\$") > "$logs/processes.log" 2>&1
+# packaging.install_consumer builds its three consumers in a scratch directory with plain CMake, most
+# of this suite's time: through ccache, with paths taken relative (the scratch name changes every run).
+(cd "$build" && CMAKE_C_COMPILER_LAUNCHER=ccache CMAKE_CXX_COMPILER_LAUNCHER=ccache CCACHE_BASEDIR=/ \
+   ctest --output-on-failure -j "$((jobs + 1))" -R "^($processes)\$") > "$logs/processes.log" 2>&1
 grep -E '^ *[0-9]+/[0-9]+ Test|tests passed' "$logs/processes.log"
 count_ctest "$logs/processes.log"
 
