@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "dds_options.hpp"
 #include "discovery_cli.hpp"
 #include "monitor_readers.hpp"
 #include "rsg/dds/discovery.hpp"
@@ -26,6 +27,14 @@ struct MonitorOptions {
   dds::DiscoveryOptions discovery;
 
   MonitorTopics topics() const { return {topic, status_topic, partitions, view_profile, qos_profile}; }
+
+  /// Loads --profiles and looks up every profile the options name (dds_options.hpp).
+  /// @throws rsg::InputError naming the flag of a file or profile that is not there.
+  void load_profiles() const {
+    load_profile_options(profiles, participant_profile);
+    check_profiles({{"--view", NamedProfile::Kind::kDataReader, view_profile},
+                    {"--qos", NamedProfile::Kind::kDataReader, qos_profile}});
+  }
 };
 
 /// `without_status` completes the --status-topic help: what an empty topic name means to the tool.
@@ -33,17 +42,16 @@ inline void add_monitor_options(CLI::App& app, MonitorOptions& options, const st
   app.add_option("--domain", options.domain, "DDS domain id")
       ->check(CLI::Range(0, 232))
       ->capture_default_str();
-  app.add_option("--topic", options.topic, "RobotState topic")->capture_default_str();
+  app.add_option("--topic", options.topic, "RobotState topic")->check(dds_name(false))->capture_default_str();
   app.add_option("--status-topic", options.status_topic, "GatewayStatus topic; \"\" " + without_status)
+      ->check(dds_name(true))
       ->capture_default_str();
-  app.add_option("--partition", options.partitions, "DDS partition (repeatable; default: none)");
+  app.add_option("--partition", options.partitions, "DDS partition (repeatable; default: none)")
+      ->check(dds_name(true));
   app.add_option("--view", options.view_profile,
                  "View profile, e.g. view_joints: only samples carrying its groups");
   app.add_option("--qos", options.qos_profile, "Reader QoS profile")->capture_default_str();
-  app.add_option("--profiles", options.profiles, "XML profile file or directory (repeatable)")
-      ->default_str(dds::default_profiles_dir().string());
-  app.add_option("--participant-profile", options.participant_profile, "XML participant profile")
-      ->capture_default_str();
+  add_profile_options(app, options.profiles, options.participant_profile);
   add_discovery_options(app, options.discovery);
 }
 

@@ -65,9 +65,26 @@ inline void init_logging(std::string_view tool) {
 /// and level, "[2026-11-24 23:31:50.262] [rsg_gateway] [info] ...", for a log read afterwards.
 inline void log_with_timestamps() { spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%l] %v"); }
 
+/// Adds to every unsigned option of `app`, its option groups and subcommands a check that the value
+/// is not negative: CLI11 2.1 converts "-1" to the largest unsigned value without a word.
+inline void refuse_negative_unsigned(CLI::App& app) {
+  for (CLI::Option* option : app.get_options())
+    if (option->get_type_name().starts_with("UINT"))
+      option->check(CLI::Validator(
+          [](const std::string& value) {
+            const auto first = value.find_first_not_of(" \t");
+            return first != std::string::npos && value[first] == '-' ? "'" + value + "' is negative"
+                                                                     : std::string();
+          },
+          "", "not negative"));
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))  // option groups too
+    refuse_negative_unsigned(*sub);
+}
+
 /// Parses the command line; returns the exit status when the tool must stop here (--help: 0, with
 /// the help on stdout; a parse error: 2, logged as "<tool>: <what> (see --help)"), or nothing to go on.
 inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
+  refuse_negative_unsigned(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

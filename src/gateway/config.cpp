@@ -1,14 +1,18 @@
 #include "config.hpp"
 
+#include <fmt/format.h>
 #include <sched.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <set>
 
 #include "rsg/dds/ros2.hpp"
 #include "rsg/transport/host_port.hpp"
+#include "rsg/wire/frame.hpp"
 #include "rsg/wire/number.hpp"
 #include "source_filter.hpp"
 
@@ -38,6 +42,15 @@ std::string check_range(int value, int low, int high) {
 
 std::string check_not_empty(const std::string& value) { return value.empty() ? "must not be empty" : ""; }
 
+// A topic, partition or gateway name: no control character, which would split the log lines, the
+// status and the metrics that show it.
+std::string check_name(const std::string& value, bool may_be_empty) {
+  if (!may_be_empty && value.empty()) return "must not be empty";
+  if (std::ranges::any_of(value, [](unsigned char c) { return c < 0x20 || c == 0x7f; }))
+    return "must not contain control characters";
+  return {};
+}
+
 // The first complaint of `parse` (a parser returning wire::Parsed) about one of `values`, or "".
 template <class Parse>
 std::string check_each(const std::vector<std::string>& values, Parse parse) {
@@ -52,11 +65,26 @@ std::string check_decimation(const std::string& value) {
              : "'" + value + "' is not HZ (in (0, 10000]) or every:N (N in 1..1000000)";
 }
 
+// At most `limit` items, and none twice.
+std::string check_list_size(const std::vector<std::string>& values, std::size_t limit) {
+  if (values.size() > limit)
+    return std::to_string(values.size()) + " entries, at most " + std::to_string(limit) + " are allowed";
+  return {};
+}
+
+std::string lowercase(std::string text) {
+  std::ranges::transform(text, text.begin(),
+                         [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
+}
+
 std::string check_frame(const std::string& value) {
   return value.empty()            ? "must not be empty"
          : value.starts_with('/') ? "TF frame ids do not start with '/'"
                                   : "";
 }
+
+constexpr std::array<std::string_view, 6> kLogLevels = {"trace", "debug", "info", "warn", "error", "off"};
 
 const std::array kKeys = {
     ConfigKey{"listen", "Receive raw frames on HOST:PORT (UDP) and publish them", &GatewayConfig::listen,
@@ -67,18 +95,19 @@ const std::array kKeys = {
     ConfigKey{"allow-from", "Accept frames only from ADDR[/PREFIX] (repeatable; IPv4 or IPv6)",
               &GatewayConfig::allow_from,
               [](const GatewayConfig& c) {
+                if (auto error = check_list_size(c.allow_from, kMaxAllowFrom); !error.empty()) return error;
                 for (const auto& network : c.allow_from)
                   if (const auto parsed = parse_network(network); !parsed) return parsed.error();
                 return std::string();
               }},
     ConfigKey{"topic", "Topic the received frames are published on", &GatewayConfig::topic,
-              [](const GatewayConfig& c) { return check_not_empty(c.topic); }},
+              [](const GatewayConfig& c) { return check_name(c.topic, false); }},
     ConfigKey{"domain", "DDS domain id", &GatewayConfig::domain,
               [](const GatewayConfig& c) {
                 return c.domain >= 0 && c.domain <= 232 ? "" : std::to_string(c.domain) + " is not in 0..232";
               }},
     ConfigKey{"partition", "DDS partition of every topic (default: none)", &GatewayConfig::partition,
-              [](const GatewayConfig&) { return std::string(); }},
+              [](const GatewayConfig& c) { return check_name(c.partition, true); }},
     ConfigKey{
         "receive-buffer", "Kernel UDP receive buffer, bytes", &GatewayConfig::receive_buffer,
         [](const GatewayConfig& c) { return c.receive_buffer >= 0 ? "" : std::string("must be >= 0"); }},
@@ -89,15 +118,22 @@ const std::array kKeys = {
         "(every Nth frame), e.g. robot_state_50hz:50 or robot_state_tenth:every:10 (repeatable)",
         &GatewayConfig::rate_topics,
         [](const GatewayConfig& c) {
-          for (const auto& value : c.rate_topics)
-            if (!parse_rate_topic(value))
+          if (auto error = check_list_size(c.rate_topics, kMaxRateTopics); !error.empty()) return error;
+          std::set<std::string, std::less<>> names;
+          for (const auto& value : c.rate_topics) {
+            const auto rate = parse_rate_topic(value);
+            if (!rate)
               return "'" + value + "' is not NAME:HZ with HZ in (0, 10000] nor NAME:every:N with N >= 1";
+            if (!names.insert(rate->name).second) return "'" + rate->name + "' is given twice";
+          }
           return std::string();
         }},
     ConfigKey{"egress-topic", "Send the samples of this topic as raw frames to --send-to",
-              &GatewayConfig::egress_topic, [](const GatewayConfig&) { return std::string(); }},
+              &GatewayConfig::egress_topic,
+              [](const GatewayConfig& c) { return check_name(c.egress_topic, true); }},
     ConfigKey{"send-to", "Destination HOST:PORT of egress frames (repeatable)", &GatewayConfig::send_to,
               [](const GatewayConfig& c) {
+                if (auto error = check_list_size(c.send_to, kMaxSendTo); !error.empty()) return error;
                 for (const auto& destination : c.send_to)
                   if (auto error = check_host_port(destination, transport::HostPortRule::kPortRequired);
                       !error.empty())
@@ -126,7 +162,7 @@ const std::array kKeys = {
                                                 : wire::parse_field_list(join(c.request_fields)).error();
               }},
     ConfigKey{"status-topic", "Topic of the GatewayStatus samples", &GatewayConfig::status_topic,
-              [](const GatewayConfig& c) { return check_not_empty(c.status_topic); }},
+              [](const GatewayConfig& c) { return check_name(c.status_topic, false); }},
     ConfigKey{"expected-rate",
               "Nominal frame rate, Hz (the link is down after 10 silent periods, at least 10 ms)",
               &GatewayConfig::expected_rate,
@@ -154,7 +190,7 @@ const std::array kKeys = {
     ConfigKey{"name",
               "This gateway's name: the `gateway` label of its metrics (default: the partition, else the "
               "host's name)",
-              &GatewayConfig::name, [](const GatewayConfig&) { return std::string(); }},
+              &GatewayConfig::name, [](const GatewayConfig& c) { return check_name(c.name, true); }},
     ConfigKey{"metrics-max-connections",
               "Connections --metrics holds open at once; at the limit the oldest one still waiting for its "
               "request makes room (docs/security.md)",
@@ -174,13 +210,22 @@ const std::array kKeys = {
               "Time a kept-alive --metrics connection may wait for its next request",
               &GatewayConfig::metrics_idle_timeout_ms,
               [](const GatewayConfig& c) { return check_range(c.metrics_idle_timeout_ms, 10, 3600000); }},
-    ConfigKey{"pcap-ring",
-              "Flight recorder: keep the last SECONDS of raw datagrams in memory and write them as a pcap "
-              "file into --pcap-dir on SIGUSR1 and when the link goes down; 0: off",
-              &GatewayConfig::pcap_ring,
-              [](const GatewayConfig& c) {
-                return c.pcap_ring >= 0 && c.pcap_ring <= 600 ? std::string() : "must be in 0..600";
-              }},
+    ConfigKey{
+        "pcap-ring",
+        "Flight recorder: keep the last SECONDS of raw datagrams in memory and write them as a pcap "
+        "file into --pcap-dir on SIGUSR1 and when the link goes down; 0: off",
+        &GatewayConfig::pcap_ring,
+        [](const GatewayConfig& c) {
+          if (!(c.pcap_ring >= 0 && c.pcap_ring <= 600)) return std::string("must be in 0..600");
+          // The ring is allocated up front: refuse here what would be std::bad_alloc at start-up.
+          if (c.pcap_ring * c.expected_rate > kMaxFlightRecorderDatagrams)
+            return fmt::format(
+                "{:g} s at --expected-rate {:g} is {:.0f} datagrams to keep, at most {:.0f} are allowed "
+                "(a ring of {:.0f} MB)",
+                c.pcap_ring, c.expected_rate, c.pcap_ring * c.expected_rate, kMaxFlightRecorderDatagrams,
+                2 * kMaxFlightRecorderDatagrams * static_cast<double>(wire::kMaxFrameBytes) / 1e6);
+          return std::string();
+        }},
     ConfigKey{"pcap-dir", "Directory the flight recorder's pcap files go to", &GatewayConfig::pcap_dir,
               [](const GatewayConfig&) { return std::string(); }},
     ConfigKey{"pcap-min-interval",
@@ -213,9 +258,8 @@ const std::array kKeys = {
               &GatewayConfig::pcap_all_sources, [](const GatewayConfig&) { return std::string(); }},
     ConfigKey{"log-level", "trace, debug, info, warn, error or off", &GatewayConfig::log_level,
               [](const GatewayConfig& c) {
-                static constexpr std::array kLevels = {"trace", "debug", "info", "warn", "error", "off"};
-                for (const char* level : kLevels)
-                  if (c.log_level == level) return std::string();
+                const std::string level = lowercase(c.log_level);
+                if (std::ranges::find(kLogLevels, level) != kLogLevels.end()) return std::string();
                 return "'" + c.log_level + "' is not one of trace, debug, info, warn, error, off";
               }},
     ConfigKey{"log-format",
@@ -290,8 +334,15 @@ const std::array kKeys = {
     ConfigKey{"wrench-frame", "frame_id of external_wrench (O_F_ext_hat_K is expressed in the base frame O)",
               &GatewayConfig::wrench_frame,
               [](const GatewayConfig& c) { return check_frame(c.wrench_frame); }},
-    ConfigKey{"profiles", "Fast DDS XML profile file or directory (default: rsg's xml_profiles)",
-              &GatewayConfig::profiles, [](const GatewayConfig&) { return std::string(); }},
+    ConfigKey{"profiles",
+              "Fast DDS XML profile file or directory; repeat or separate with commas to load several, in "
+              "order (default: rsg's xml_profiles)",
+              &GatewayConfig::profiles,
+              [](const GatewayConfig& c) {
+                for (const auto& path : c.profiles)
+                  if (path.empty()) return std::string("an empty path");
+                return std::string();
+              }},
     ConfigKey{"participant-profile", "XML participant profile", &GatewayConfig::participant_profile,
               [](const GatewayConfig& c) { return check_not_empty(c.participant_profile); }},
     ConfigKey{"writer-profile", "XML data writer profile of the state topic", &GatewayConfig::writer_profile,
@@ -312,6 +363,47 @@ const ConfigKey* find_key(std::string_view name) {
   for (const ConfigKey& key : kKeys)
     if (key.name == name) return &key;
   return nullptr;
+}
+
+// Edits (insert, delete, substitute) from `a` to `b`: Levenshtein's distance, on short key names.
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// A top-level line of a YAML mapping that is not `key: value` ("topic robot"): yaml-cpp reads it as
+// the start of a multi-line key and reports the line after it ("illegal map value"), so a syntax
+// error is traced back to such a line when one precedes it. Returns its 1-based number, or 0.
+int line_without_colon(std::string_view text, int up_to_line) {
+  int found = 0;
+  int number = 0;
+  std::size_t begin = 0;
+  while (begin <= text.size() && number < up_to_line) {
+    const std::size_t end = std::min(text.find('\n', begin), text.size());
+    std::string_view line = text.substr(begin, end - begin);
+    begin = end + 1;
+    ++number;
+    if (line.ends_with('\r')) line.remove_suffix(1);
+    if (const auto hash = line.find(" #"); hash != std::string_view::npos) line = line.substr(0, hash);
+    while (!line.empty() && (line.back() == ' ' || line.back() == '\t')) line.remove_suffix(1);
+    // Only unindented plain lines: anything else continues a value or is YAML syntax of its own.
+    if (line.empty() || line.front() == ' ' || line.front() == '\t' || line.front() == '#' ||
+        line.front() == '-' || line.front() == '.' || line.front() == ']' || line.front() == '}' ||
+        line.front() == '%')
+      continue;
+    if (line.find(": ") == std::string_view::npos && !line.ends_with(':')) found = number;
+  }
+  return found;
 }
 
 std::string known_keys() {
@@ -399,7 +491,12 @@ ConfigResult parse_gateway_config(std::string_view yaml_text, const GatewayConfi
       if (!entry.first.IsScalar()) return ConfigError{line, "keys must be plain names"};
       const std::string& name = entry.first.Scalar();
       const ConfigKey* key = find_key(name);
-      if (!key) return ConfigError{line, "unknown key '" + name + "' (known: " + known_keys() + ")"};
+      if (!key) {
+        if (const auto nearest = nearest_key(name))
+          return ConfigError{line,
+                             "unknown key '" + name + "': did you mean '" + std::string(*nearest) + "'?"};
+        return ConfigError{line, "unknown key '" + name + "' (known: " + known_keys() + ")"};
+      }
       if (!seen.insert(name).second) return ConfigError{line, "'" + name + "' is given twice"};
       if (entry.second.IsNull()) return ConfigError{line, name + ": has no value"};
       if (auto error = assign(config, key->member, entry.second); !error.empty())
@@ -408,10 +505,33 @@ ConfigResult parse_gateway_config(std::string_view yaml_text, const GatewayConfi
     }
     return config;
   } catch (const YAML::Exception& error) {
-    return ConfigError{line_of(error.mark), error.msg};
+    const int line = line_of(error.mark);
+    if (const int missing_colon = line > 0 ? line_without_colon(yaml_text, line) : 0; missing_colon > 0)
+      return ConfigError{missing_colon, "not a 'key: value' line (a missing ':' after the key?)"};
+    return ConfigError{line, error.msg};
   } catch (const std::exception& error) {  // e.g. std::bad_alloc from a huge document
     return ConfigError{0, error.what()};
   }
+}
+
+std::string log_level_name(const GatewayConfig& config) { return lowercase(config.log_level); }
+
+std::optional<std::string_view> nearest_key(std::string_view name) {
+  // "stats_file", "Stats-File": the spelling of the flags differs only in case and '-'.
+  std::string normalized = lowercase(std::string(name));
+  std::ranges::replace(normalized, '_', '-');
+  const ConfigKey* best = nullptr;
+  std::size_t best_distance = 0;
+  for (const ConfigKey& key : kKeys) {
+    const std::size_t distance = edit_distance(normalized, key.name);
+    if (best == nullptr || distance < best_distance) {
+      best = &key;
+      best_distance = distance;
+    }
+  }
+  // A third of the name may be wrong ("lissten", "expected_rates"), never a different word.
+  if (best == nullptr || best_distance > std::max<std::size_t>(1, best->name.size() / 3)) return std::nullopt;
+  return best->name;
 }
 
 std::optional<std::string> check_config(const GatewayConfig& config) {

@@ -8,6 +8,7 @@
 // List keys take a YAML sequence or a comma-separated string, as on the command line.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <span>
 #include <string>
@@ -90,7 +91,8 @@ struct GatewayConfig {
   std::string wrench_frame = "panda_link0";  ///< as franka_ros2's state broadcaster: O is link0
 
   // Fast DDS XML profiles
-  std::string profiles;  ///< empty: rsg::dds::default_profiles_dir()
+  std::vector<std::string>
+      profiles;  ///< files or directories, loaded in order; empty: default_profiles_dir()
   std::string participant_profile = "rsg_participant";
   std::string writer_profile = "rsg_state_writer";
   std::string reader_profile = "rsg_state_reader";
@@ -104,6 +106,16 @@ struct GatewayConfig {
   bool has_egress() const { return !egress_topic.empty() || (ros2 && !send_to.empty()); }
   bool requests_selection() const { return !request_groups.empty() || !request_fields.empty(); }
 };
+
+/// Upper limits of the values whose product the gateway allocates or walks per datagram at start-up,
+/// so that a configuration that cannot run is refused when it is read, not by std::bad_alloc (or a
+/// gateway that spends its time in a list) once running. docs/configuration.md, "Limits".
+inline constexpr std::size_t kMaxAllowFrom = 256;  ///< networks, each compared with every datagram's source
+inline constexpr std::size_t kMaxRateTopics = 32;  ///< each a DDS writer with the state writer's history
+inline constexpr std::size_t kMaxSendTo = 64;      ///< egress destinations, one send each per sample
+/// pcap-ring × expected-rate: the flight recorder preallocates twice this many datagram slots of
+/// wire::kMaxFrameBytes each (120 s at 1 kHz, about 513 MB).
+inline constexpr double kMaxFlightRecorderDatagrams = 120000;
 
 /// One configuration key: its name (the long flag without "--" and the YAML key), its help text,
 /// the member it sets, and the check its value must pass.
@@ -148,6 +160,13 @@ ConfigResult parse_gateway_config(std::string_view yaml_text, const GatewayConfi
 /// Checks every value and how the keys combine (e.g. `--send-to` needs `--egress-topic`).
 /// Returns what is wrong, or nothing.
 std::optional<std::string> check_config(const GatewayConfig& config);
+
+/// The spdlog level name of `log-level` (given in any case: "WARN" is "warn"); assumes a checked config.
+std::string log_level_name(const GatewayConfig& config);
+
+/// The key nearest to `name` when it is probably a misspelling of one ("stats_file", "lissten"),
+/// else nothing.
+std::optional<std::string_view> nearest_key(std::string_view name);
 
 /// One `rate-topic` value "NAME:HZ" or "NAME:every:N" split, or nothing when it is neither.
 struct RateTopic {

@@ -84,12 +84,15 @@ void check_output_files(const GatewayConfig& config) {
   if (config.pcap_ring > 0) check_writable_dir("pcap-dir", config.pcap_dir, config.pcap_dir + "/*.pcap");
 }
 
-std::filesystem::path profiles_of(const GatewayConfig& config) {
-  return config.profiles.empty() ? dds::default_profiles_dir() : std::filesystem::path(config.profiles);
+// The --profiles files or directories, for messages: "a.xml, b/" (or rsg's directory).
+std::string profiles_of(const GatewayConfig& config) {
+  return config.profiles.empty() ? dds::default_profiles_dir().string()
+                                 : fmt::format("{}", fmt::join(config.profiles, ", "));
 }
 
-InputError no_profile(const GatewayConfig& config, const std::string& kind, const std::string& name) {
-  return InputError(profiles_of(config).string() + ": no " + kind + " profile named '" + name + "'");
+InputError no_profile(const GatewayConfig& config, const std::string& flag, const std::string& kind,
+                      const std::string& name) {
+  return InputError("--" + flag + ": no " + kind + " profile named '" + name + "' in " + profiles_of(config));
 }
 
 // The participant profile's QoS, with systemd's credentials directory in its properties
@@ -98,7 +101,7 @@ fdds::DomainParticipantQos profile_participant_qos(const GatewayConfig& config) 
   fdds::DomainParticipantQos qos;
   if (fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
           config.participant_profile, qos) != dds::kOk)
-    throw no_profile(config, "participant", config.participant_profile);
+    throw no_profile(config, "participant-profile", "participant", config.participant_profile);
   for (auto& property : qos.properties().properties())
     property.value() = expand_credentials_directory(
         property.value(), std::getenv("CREDENTIALS_DIRECTORY"),
@@ -107,7 +110,12 @@ fdds::DomainParticipantQos profile_participant_qos(const GatewayConfig& config) 
 }
 
 void load_and_check_profiles(const GatewayConfig& config) {
-  dds::load_profiles(profiles_of(config));
+  try {
+    if (config.profiles.empty()) dds::load_profiles(dds::default_profiles_dir());
+    for (const auto& file_or_dir : config.profiles) dds::load_profiles(std::filesystem::path(file_or_dir));
+  } catch (const InputError& error) {
+    throw InputError(std::string("--profiles: ") + error.what());
+  }
   profile_participant_qos(config);
 }
 
@@ -128,11 +136,11 @@ dds::Participant& check_entity_profiles(dds::Participant& participant, const Gat
     return subscriber->get_datareader_qos_from_profile(name, qos) == dds::kOk;
   };
   if (!has_writer_profile(config.status_profile))
-    throw no_profile(config, "data_writer", config.status_profile);
+    throw no_profile(config, "status-profile", "data_writer", config.status_profile);
   if (config.has_ingress() && !has_writer_profile(config.writer_profile))
-    throw no_profile(config, "data_writer", config.writer_profile);
+    throw no_profile(config, "writer-profile", "data_writer", config.writer_profile);
   if (config.has_egress() && !has_reader_profile(config.reader_profile))
-    throw no_profile(config, "data_reader", config.reader_profile);
+    throw no_profile(config, "reader-profile", "data_reader", config.reader_profile);
   return participant;
 }
 
@@ -425,7 +433,7 @@ void Gateway::reload(const GatewayConfig& fresh) {
                  fmt::join(need_restart, ", "));
   // Last, so that lowering the level does not hide the lines above.
   config_.log_level = fresh.log_level;
-  spdlog::set_level(spdlog::level::from_str(fresh.log_level));
+  spdlog::set_level(spdlog::level::from_str(log_level_name(fresh)));  // checked: any case
 }
 
 GatewayStats Gateway::on_status_period(Clock::time_point now) {

@@ -13,11 +13,15 @@
 
 #include <CLI/CLI.hpp>
 #include <atomic>
+#include <cerrno>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
 
 #include "config.hpp"
+#include "config_check.hpp"
+#include "errno_text.hpp"
 #include "gateway.hpp"
 #include "journal_log.hpp"
 #include "rsg/error.hpp"
@@ -40,10 +44,21 @@ constexpr const char* kRealtimeHelp = R"(Real-time mode applies to the ingress t
   --cpu CPU        needs only a CPU of the process's cpuset (taskset, docker --cpuset-cpus).
 Whatever is refused is logged as one warning and the gateway runs without it.)";
 
+// What the command line says besides the configuration keys.
+struct Command {
+  std::string config_file;
+  bool check_only = false;  ///< --check-config: check everything, start nothing
+};
+
 // Every config key becomes a long flag bound to `config`; CLI11 writes only the flags that are
 // given, so binding them to a configuration read from the file makes flags override the file.
-void add_config_flags(CLI::App& app, GatewayConfig& config, std::string& config_file) {
-  app.add_option("--config", config_file, "YAML file with the same keys as the long flags (flags win)");
+void add_config_flags(CLI::App& app, GatewayConfig& config, Command& command) {
+  app.add_option("--config", command.config_file,
+                 "YAML file with the same keys as the long flags (flags win)");
+  app.add_flag("--check-config,--check", command.check_only,
+               "Check the configuration (flags, --config file, XML profiles, addresses, files to write) "
+               "the way a start does, print what it found and exit: 0 when the gateway would start with "
+               "it, 2 when not; opens no socket and creates no DDS participant");
   for (const rsg::gateway::ConfigKey& key : rsg::gateway::config_keys()) {
     const std::string flag = "--" + std::string(key.name);
     const std::string help(key.help);
@@ -65,7 +80,7 @@ void add_config_flags(CLI::App& app, GatewayConfig& config, std::string& config_
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw rsg::InputError(path + ": cannot read");
+  if (!in) throw rsg::InputError("--config: cannot read " + path + ": " + rsg::gateway::errno_text(errno));
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();
@@ -84,7 +99,7 @@ GatewayConfig read_config(const std::string& config_file, const GatewayConfig& f
   }
   GatewayConfig config = parsed.config();
   CLI::App app("rsg_gateway", "rsg_gateway");
-  std::string ignored;
+  Command ignored;
   add_config_flags(app, config, ignored);
   app.parse(argc, argv);  // accepted once already
   return config;
@@ -103,14 +118,22 @@ int main(int argc, char** argv) {
                                    rsg::gateway::fastdds_version()),
                        "Print rsg's version and the Fast DDS version it was built with, and exit");
   GatewayConfig flags_only;
-  std::string config_file;
-  add_config_flags(app, flags_only, config_file);
+  Command command;
+  add_config_flags(app, flags_only, command);
 
   return rsg::app::run_main(app, argc, argv, [&] {
-    const GatewayConfig config = read_config(config_file, flags_only, argc, argv);
-    spdlog::set_level(spdlog::level::from_str(config.log_level));
+    const GatewayConfig config = read_config(command.config_file, flags_only, argc, argv);
+    // Every value is checked before any is used: a log level spdlog does not know would otherwise
+    // turn the log off, this message with it.
+    if (auto problem = rsg::gateway::check_config(config)) throw rsg::InputError(*problem);
+    spdlog::set_level(spdlog::level::from_str(rsg::gateway::log_level_name(config)));
     if (config.log_format == "json") rsg::gateway::use_json_log_lines();  // every line from here on
     const rsg::gateway::GatewaySetup setup = rsg::gateway::prepare(config);
+    if (command.check_only) {
+      rsg::gateway::check_entity_profiles_offline(config);
+      std::fputs(rsg::gateway::describe_setup(setup, command.config_file).c_str(), stdout);
+      return kExitOk;
+    }
     // SIGUSR1 asks for a flight-recorder dump: the loop takes it when it sees `dump`. SIGHUP's
     // configuration is read here, on the signal's thread (the loop never waits on a file), and
     // applied by the loop.
@@ -119,7 +142,7 @@ int main(int argc, char** argv) {
     rsg::gateway::PendingReload reload;
     const auto reread = [&] {
       try {
-        reload.offer(read_config(config_file, flags_only, argc, argv));
+        reload.offer(read_config(command.config_file, flags_only, argc, argv));
       } catch (const std::exception& error) {  // a bad file must not end a running gateway
         reload.offer(std::string(error.what()));
       }

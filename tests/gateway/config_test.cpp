@@ -79,6 +79,88 @@ TEST(GatewayConfig, UnknownKeyNamesItsLine) {
   EXPECT_NE(error.message.find("lissten"), std::string::npos);
 }
 
+TEST(GatewayConfig, UnknownKeySuggestsTheNearest) {
+  const ConfigError underscore = parse_error("listen: 0.0.0.0:5000\nstats_file: /run/rsg/stats.json\n");
+  EXPECT_EQ(underscore.line, 2);
+  EXPECT_EQ(underscore.message, "unknown key 'stats_file': did you mean 'stats-file'?");
+  EXPECT_NE(parse_error("lissten: x").message.find("did you mean 'listen'?"), std::string::npos);
+  EXPECT_NE(parse_error("Expected_Rate: 5").message.find("did you mean 'expected-rate'?"), std::string::npos);
+  // Nothing near: the list of every key instead of a guess.
+  const ConfigError far = parse_error("colour: blue");
+  EXPECT_EQ(far.message.find("did you mean"), std::string::npos);
+  EXPECT_NE(far.message.find("known: listen, allow-from"), std::string::npos);
+  EXPECT_EQ(nearest_key("xyz"), std::nullopt);
+}
+
+TEST(GatewayConfig, MissingColonNamesTheLineItIsMissingFrom) {
+  // yaml-cpp itself reports line 4 ("illegal map value"): the key of line 3 runs on into it.
+  const ConfigError error =
+      parse_error("listen: 127.0.0.1:5000\ndomain: 3\ntopic robot\nexpected-rate: 1000\n");
+  EXPECT_EQ(error.line, 3);
+  EXPECT_NE(error.message.find("missing ':'"), std::string::npos) << error.message;
+  // Comments, list items and indented continuations are not such lines.
+  EXPECT_EQ(
+      parse_error("# gateway\nallow-from:\n- 10.0.0.1\nsend-to: [a:1,\n  b:2]\ntopic x\ndomain: 1\n").line,
+      6);
+}
+
+TEST(GatewayConfig, LogLevelInAnyCase) {
+  const GatewayConfig config = parse_ok("log-level: WARN");
+  EXPECT_EQ(log_level_name(config), "warn");
+  EXPECT_NE(parse_error("log-level: verbose").message.find("'verbose' is not one of"), std::string::npos);
+}
+
+TEST(GatewayConfig, NamesWithoutControlCharacters) {
+  EXPECT_EQ(parse_error("domain: 1\npartition: \"a\\nb\"\n").line, 2);
+  EXPECT_NE(parse_error("name: \"x\\ty\"").message.find("control characters"), std::string::npos);
+  EXPECT_NE(parse_error("topic: \"\"").message.find("must not be empty"), std::string::npos);
+}
+
+TEST(GatewayConfig, ProfilesAreAListLikeTheTools) {
+  EXPECT_EQ(parse_ok("profiles: [a.xml, dir]").profiles, (std::vector<std::string>{"a.xml", "dir"}));
+  EXPECT_EQ(parse_ok("profiles: a.xml,dir").profiles, (std::vector<std::string>{"a.xml", "dir"}));
+  EXPECT_EQ(parse_ok("profiles: a.xml").profiles, (std::vector<std::string>{"a.xml"}));
+  EXPECT_NE(parse_error("profiles: a.xml,,b").message.find("empty path"), std::string::npos);
+}
+
+// What the gateway would allocate, or walk per datagram, at start-up is bounded when it is read:
+// these were accepted and then failed with std::bad_alloc (or took gigabytes) at start-up.
+TEST(GatewayConfig, ValuesThatCannotBeAllocatedAreRefusedByName) {
+  GatewayConfig config;
+  config.listen = "127.0.0.1:17000";
+  config.pcap_dir = "/tmp";
+  config.pcap_ring = 600;
+  config.expected_rate = 100000;
+  const auto ring = check_config(config);
+  ASSERT_TRUE(ring.has_value());
+  EXPECT_NE(ring->find("--pcap-ring"), std::string::npos) << *ring;
+  EXPECT_NE(ring->find("--expected-rate 100000"), std::string::npos) << *ring;
+  config.pcap_ring = 120;  // 120 s at 1 kHz: the largest ring allowed
+  config.expected_rate = 1000;
+  EXPECT_FALSE(check_config(config).has_value()) << *check_config(config);
+
+  GatewayConfig rates;
+  rates.listen = "127.0.0.1:17000";
+  for (int i = 0; i < 2000; ++i) rates.rate_topics.push_back("rate" + std::to_string(i) + ":10");
+  EXPECT_NE(check_config(rates).value_or("").find("--rate-topic: 2000 entries, at most 32"),
+            std::string::npos);
+  rates.rate_topics = {"a:10", "a:every:2"};
+  EXPECT_NE(check_config(rates).value_or("").find("'a' is given twice"), std::string::npos);
+
+  GatewayConfig sources;
+  sources.listen = "127.0.0.1:17000";
+  sources.allow_from.assign(200000, "10.0.0.1");
+  EXPECT_NE(check_config(sources).value_or("").find("--allow-from: 200000 entries, at most 256"),
+            std::string::npos);
+  sources.allow_from.assign(kMaxAllowFrom, "10.0.0.1");
+  EXPECT_FALSE(check_config(sources).has_value());
+
+  GatewayConfig egress;
+  egress.egress_topic = "cmd";
+  egress.send_to.assign(kMaxSendTo + 1, "127.0.0.1:9");
+  EXPECT_NE(check_config(egress).value_or("").find("--send-to: 65 entries"), std::string::npos);
+}
+
 TEST(GatewayConfig, WrongTypesNameKeyAndLine) {
   EXPECT_EQ(parse_error("topic: t\ndomain: seven\n").line, 2);
   EXPECT_NE(parse_error("domain: 3.5").message.find("domain"), std::string::npos);

@@ -21,6 +21,7 @@
 #include <stop_token>
 #include <thread>
 
+#include "dds_options.hpp"
 #include "discovery_cli.hpp"
 #include "live_table.hpp"
 #include "matched_writers.hpp"
@@ -135,8 +136,11 @@ void add_options(CLI::App& app, Options& options) {
   app.add_option("--domain", options.domain, "DDS domain id")
       ->check(CLI::Range(0, 232))
       ->capture_default_str();
-  app.add_option("--topic", options.topic, "RobotState topic")->capture_default_str();
-  app.add_option("--partition", options.partitions, "DDS partition (repeatable; default: none)");
+  app.add_option("--topic", options.topic, "RobotState topic")
+      ->check(rsg::app::dds_name(false))
+      ->capture_default_str();
+  app.add_option("--partition", options.partitions, "DDS partition (repeatable; default: none)")
+      ->check(rsg::app::dds_name(true));
   app.add_flag(
       "--ros2", options.ros2,
       "Read what rsg_gateway --ros2 writes: topic rt/<ns>/<topic>, type rsg_msgs::msg::dds_::RobotState_");
@@ -157,13 +161,8 @@ void add_options(CLI::App& app, Options& options) {
                  "Exit 1 when no sample arrives for this many seconds, from start-up or the last "
                  "sample (default: wait forever)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--profiles", options.profiles,
-                 "XML profile file or directory; repeat to load several (e.g. rsg's profiles and a secure "
-                 "participant profile)")
-      ->default_str(rsg::dds::default_profiles_dir().string());
-  app.add_option("--participant-profile", options.participant_profile,
-                 "XML participant profile, e.g. rsg_secure_reader under DDS Security")
-      ->capture_default_str();
+  rsg::app::add_profile_options(app, options.profiles, options.participant_profile,
+                                "XML participant profile, e.g. rsg_secure_reader under DDS Security");
   rsg::app::add_discovery_options(app, options.discovery);
 }
 
@@ -287,7 +286,9 @@ int main(int argc, char** argv) {
   Options options;
   add_options(app, options);
   return run_main(app, argc, argv, [&] {
-    rsg::dds::load_profiles(options.profiles, options.participant_profile);
+    rsg::app::load_profile_options(options.profiles, options.participant_profile);
+    rsg::app::check_profiles({{"--view", rsg::app::NamedProfile::Kind::kDataReader, options.view_profile},
+                              {"--qos", rsg::app::NamedProfile::Kind::kDataReader, options.qos_profile}});
     return run(options);
   });
 }

@@ -16,6 +16,7 @@
 
 #include "dds/internal/fastdds_compat.hpp"
 #include "discovery_cli.hpp"
+#include "file_options.hpp"
 #include "matched_writers.hpp"
 #include "mcap_recover.hpp"
 #include "mcap_writer.hpp"
@@ -257,7 +258,7 @@ class Recording {
 };
 
 void add_options(CLI::App& app, Options& options) {
-  app.add_option("--out", options.out, "MCAP file to write")->required();
+  app.add_option("--out", options.out, "MCAP file to write")->required()->check(rsg::app::writable_file());
   rsg::app::add_monitor_options(app, options, "records none");
   app.add_option("--profile", options.profile,
                  "MCAP flavour: omgidl (default: rsg's IDL, for Foxglove) or ros2 (ros2msg schemas and the "
@@ -450,7 +451,7 @@ int main(int argc, char** argv) {
       throw rsg::InputError(
           fmt::format("--max-size {:g} keeps no finished file of --split-size {:g}: give at least {:g}",
                       options.max_mb, options.split_mb, 2 * options.split_mb));
-    rsg::dds::load_profiles(options.profiles, options.participant_profile);
+    options.load_profiles();
     return run(options, *profile);
   });
 }

@@ -19,6 +19,7 @@
 #include <unordered_set>
 
 #include "dds/internal/fastdds_compat.hpp"
+#include "dds_options.hpp"
 #include "discovery_cli.hpp"
 #include "mcap_reader.hpp"
 #include "recording.hpp"
@@ -27,6 +28,7 @@
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/dds/views.hpp"
 #include "rsg/error.hpp"
+#include "rsg/transport/host_port.hpp"
 #include "rsg/transport/udp_socket.hpp"
 #include "stop_on_signal.hpp"
 #include "tool_main.hpp"
@@ -211,20 +213,25 @@ class Player final : public rsg::mcap::RecordVisitor {
 
 void add_options(CLI::App& app, Options& options) {
   app.add_option("file", options.file, "MCAP file written by rsg_record")->required();
-  auto* to = app.add_option("--to", options.to, "Send raw frames to HOST:PORT (as the robot did)");
+  auto* to =
+      app.add_option("--to", options.to, "Send raw frames to HOST:PORT (as the robot did)")
+          ->check([](const std::string& text) {
+            return rsg::transport::parse_host_port(text, rsg::transport::HostPortRule::kPortRequired).error();
+          });
   auto* domain = app.add_option("--domain", options.domain, "Publish DDS samples on this domain instead")
                      ->check(CLI::Range(0, 232));
   to->excludes(domain);
-  app.add_option("--topic", options.topic, "RobotState topic (with --domain)")->capture_default_str();
-  app.add_option("--partition", options.partitions, "DDS partition (with --domain; repeatable)");
+  app.add_option("--topic", options.topic, "RobotState topic (with --domain)")
+      ->check(rsg::app::dds_name(false))
+      ->capture_default_str();
+  app.add_option("--partition", options.partitions, "DDS partition (with --domain; repeatable)")
+      ->check(rsg::app::dds_name(true));
   app.add_option("--writer-profile", options.writer_profile, "DataWriter profile (with --domain)")
       ->capture_default_str();
   app.add_option("--wait-for-readers", options.wait_for_readers,
-                 "With --domain: wait up to 10 s until this many readers have matched before playing");
-  app.add_option("--profiles", options.profiles, "XML profile file or directory (repeatable)")
-      ->default_str(rsg::dds::default_profiles_dir().string());
-  app.add_option("--participant-profile", options.participant_profile, "XML participant profile")
-      ->capture_default_str();
+                 "With --domain: wait up to 10 s until this many readers have matched before playing")
+      ->check(CLI::Range(0, 1000000));
+  rsg::app::add_profile_options(app, options.profiles, options.participant_profile);
   rsg::app::add_discovery_options(app, options.discovery);
   app.add_option("--speed", options.speed, "Play this many times faster than recorded")
       ->check(CLI::PositiveNumber)
@@ -251,7 +258,9 @@ int run(const Options& options) {
 
   std::unique_ptr<Output> output;
   if (options.domain) {
-    rsg::dds::load_profiles(options.profiles, options.participant_profile);
+    rsg::app::load_profile_options(options.profiles, options.participant_profile);
+    rsg::app::check_profiles(
+        {{"--writer-profile", rsg::app::NamedProfile::Kind::kDataWriter, options.writer_profile}});
     auto dds = std::make_unique<DdsOutput>(options);
     wait_for_readers(dds->writer(), options.wait_for_readers, stop);
     output = std::move(dds);

@@ -8,9 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "file_options.hpp"
 #include "pcap_file.hpp"
 #include "replay.hpp"
 #include "rsg/error.hpp"
+#include "rsg/transport/host_port.hpp"
 #include "simulator.hpp"
 #include "stop_on_signal.hpp"
 #include "tool_main.hpp"
@@ -85,7 +87,11 @@ rsg::wire::Parsed<std::vector<rsg::wire::ErrorCategory>> parse_categories(const 
 }
 
 void add_options(CLI::App& app, Options& options, rsg::tools::sim::SimConfig& config) {
-  app.add_option("--to", options.to, "Where to send frames, HOST:PORT")->required();
+  app.add_option("--to", options.to, "Where to send frames, HOST:PORT")
+      ->check([](const std::string& text) {
+        return rsg::transport::parse_host_port(text, rsg::transport::HostPortRule::kPortRequired).error();
+      })
+      ->required();
   app.add_option("--rate", config.rate_hz, "Frames per second")
       ->check(CLI::Range(1e-3, 1e6))
       ->capture_default_str();
@@ -140,10 +146,13 @@ void add_options(CLI::App& app, Options& options, rsg::tools::sim::SimConfig& co
   faults->add_option("--restart-after", config.restart_after,
                      "After N frames, the robot reboots: time and packet number restart from 0");
 
-  app.add_option("--report", options.report_path, "Write the JSON report of what was sent to FILE");
+  app.add_option("--report", options.report_path, "Write the JSON report of what was sent to FILE")
+      ->check(rsg::app::writable_file());
   app.add_option("--record", options.record_path,
-                 "Write the canonical JSON of every valid datagram sent to FILE, one per line");
-  app.add_option("--pcap", options.pcap_path, "Also write every datagram sent to FILE as a pcap capture");
+                 "Write the canonical JSON of every valid datagram sent to FILE, one per line")
+      ->check(rsg::app::writable_file());
+  app.add_option("--pcap", options.pcap_path, "Also write every datagram sent to FILE as a pcap capture")
+      ->check(rsg::app::writable_file());
 
   auto* replay = app.add_option_group("Replay", "Send a capture's frames instead of simulating");
   auto* file =

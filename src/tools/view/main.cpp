@@ -114,7 +114,11 @@ void add_options(CLI::App& app, Options& options) {
   app.add_option("--page-rate", options.page_rate_hz, "Updates per second of the page's summary channel")
       ->check(CLI::Range(1.0, 1000.0))
       ->capture_default_str();
-  app.add_option("--chart-js", options.chart_js, "Chart.js file the page loads (Debian's libjs-chart.js)")
+  app.add_option(
+         "--chart-js", options.chart_js,
+         "Chart.js file the page loads (Debian's libjs-chart.js; when the default is missing, the page "
+         "shows numbers but no plots)")
+      ->check(CLI::ExistingFile)  // checked when given: a file named on purpose must be there
       ->capture_default_str();
 }
 
@@ -230,7 +234,7 @@ int main(int argc, char** argv) {
     options.server.idle_timeout = milliseconds_of(options.idle_timeout_s);
     options.server.stall_timeout = milliseconds_of(options.stall_timeout_s);
     split_listen(options.listen, options.server);  // the syntax is checked: a name that does not resolve
-    rsg::dds::load_profiles(options.profiles, options.participant_profile);
+    options.load_profiles();
     return run(options);
   });
 }
