@@ -113,6 +113,8 @@ int run_reporting_errors(Body&& body) {
   try {
     return std::forward<Body>(body)();
   } catch (const std::exception& error) {
+    // The reason for the exit status is written even under `--log-level off`.
+    if (!spdlog::should_log(spdlog::level::err)) spdlog::set_level(spdlog::level::err);
     spdlog::error("{}", error.what());
     return exit_status_of(error);
   }

@@ -58,7 +58,7 @@ void add_config_flags(CLI::App& app, GatewayConfig& config, Command& command) {
   app.add_flag("--check-config,--check", command.check_only,
                "Check the configuration (flags, --config file, XML profiles, addresses, files to write) "
                "the way a start does, print what it found and exit: 0 when the gateway would start with "
-               "it, 2 when not; opens no socket and creates no DDS participant");
+               "it, 2 when not; opens no socket and enables no DDS participant");
   for (const rsg::gateway::ConfigKey& key : rsg::gateway::config_keys()) {
     const std::string flag = "--" + std::string(key.name);
     const std::string help(key.help);

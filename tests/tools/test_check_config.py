@@ -89,6 +89,9 @@ def main():
                 (["--listen", listen, "--pcap-ring", "600", "--pcap-dir", tmp, "--expected-rate", "100000"],
                  "--pcap-ring: 600 s at --expected-rate 100000"),
                 (["--listen", listen, "--log-level", "verbose"], "--log-level: 'verbose' is not one of"),
+                # The reason for exit 2 is written even when the log is off.
+                (["--listen", listen, "--log-level", "off", "--writer-profile", "nowhere"],
+                 "--writer-profile: no data_writer profile named 'nowhere'"),
                 (["--listen", listen, "--stats-file", "/nonexistent/dir/stats.json"], "--stats-file: cannot write"),
                 (["--config", os.path.join(tmp, "absent.yaml")], "No such file or directory"),
         ):
@@ -99,7 +102,7 @@ def main():
             check(out == "", f"{shown} --check-config wrote to stdout: {out!r}")
     if failures:
         sys.exit(f"{len(failures)} failed")
-    print("--check-config: a good configuration 0 without binding its ports, 7 bad ones 2 with the reason")
+    print("--check-config: a good configuration 0 without binding its ports, 8 bad ones 2 with the reason")
 
 
 if __name__ == "__main__":
