@@ -131,7 +131,7 @@ def profile_errors_come_first_on_stderr(h):
     err = (h.dir / "wrong_profiles.err").read_text()
     check(status == 2, f"wrong_profiles: exit status {status}, expected 2 ({err.strip()})")
     check(h.output("wrong_profiles").read_text() == "", "Fast DDS's log went to stdout, the tool's output")
-    ours = err.find(f"rsg_echo: {wrong}: Fast DDS rejected this XML profile file")
+    ours = err.find(f"rsg_echo: --profiles: {wrong}: Fast DDS rejected this XML profile file")
     theirs = err.find("no_such_policy")
     check(ours >= 0 and 0 <= theirs < ours, f"Fast DDS's reason is not on stderr before rsg_echo's line: {err}")
 
