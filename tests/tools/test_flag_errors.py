@@ -67,6 +67,7 @@ BAD_VALUES = {
         "--receive-buffer": ["--receive-buffer", "-1"],
         "--rate-topic": ["--rate-topic", "slow"],
         "--egress-topic": ["--egress-topic", "cmd"],  # without --send-to
+        "--egress-rate": ["--egress-rate", "-1"],
         "--send-to": ["--send-to", "127.0.0.1:0"],
         "--robot": ["--robot", BAD_HOST_PORT, "--request-groups", "1"],
         "--request-groups": ["--request-groups", "6"],
@@ -126,6 +127,9 @@ BAD_VALUES = {
         "--duration": ["--duration", "-1"],
         "--recover": ["--recover", MISSING],
         "--split-size": ["--split-size", "-1"],
+        "--max-files": ["--split-size", "1", "--max-files", "1"],
+        "--max-size": ["--split-size", "1", "--max-size", "0"],
+        "--max-age": ["--split-size", "1", "--max-age", "0"],
         "--chunk-size": ["--chunk-size", "10"],
         "--fsync": ["--fsync=maybe"],
     },
