@@ -103,6 +103,9 @@ TEST_F(EmbeddedGatewayTest, CallbackSeesExactlyWhatARemoteReaderReceives) {
   for (std::size_t i = 0; i < kFrames; ++i) {
     wire::StateValues values = test::random_state(rng);
     values.packet_number = static_cast<std::uint8_t>(i % wire::kPacketNumberModulo);
+    // The robot's clock goes forward a millisecond a frame: a frame whose time does not continue
+    // the stream is not published (docs/operating.md).
+    if (values.selection.contains(wire::Field::time)) values.set_integer(wire::Field::time, 1'000'000 + i);
     Bytes frame(wire::kMaxFrameBytes);
     frame.resize(
         encode(values.packet_number, values.selection, values.storage(), wire::StateValues::layout(), frame)
