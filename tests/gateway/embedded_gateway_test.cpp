@@ -115,7 +115,9 @@ TEST_F(EmbeddedGatewayTest, CallbackSeesExactlyWhatARemoteReaderReceives) {
     else
       sent.push_back(frame);
     ASSERT_TRUE(robot.send_to(frame, to));
-    std::this_thread::sleep_for(200us);  // no burst beyond the socket buffer
+    // A frame a millisecond, as the robot's clock above: no burst beyond the socket buffer, and no
+    // frame from a future the arrival clock has not reached.
+    std::this_thread::sleep_for(1ms);
   }
 
   std::vector<Bytes> from_reader;

@@ -57,8 +57,11 @@ def body(h):
         check(f"{tool}: warning: no writer matched: this reader looks for topic 'robot_state', type "
               f"'rsg::RobotState', in partition 'robot1' on domain {domain}" in text, f"{label}: {text}")
         check(text.count("no writer matched") == 1, f"{label} said it more than once: {text}")
-    for label, process in (("echo", echo), ("record", record), ("view", view)):
+    for label, process in (("echo", echo), ("view", view)):
         check(h.stop(label, process) == 0, f"{label} did not exit 0 on SIGTERM")
+    # A recording that matched no writer is a failure, and says so (docs/record-replay.md).
+    check(h.stop("record", record) == 1, "rsg_record that matched no writer did not exit 1 on SIGTERM")
+    check("no writer of 'robot_state' matched" in stderr_of(h, "record"), stderr_of(h, "record"))
     check(h.stop("robot2", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
 
     # 1. Nobody at all on the domain; rsg_echo gives up sooner than it would explain, and explains first.

@@ -111,12 +111,13 @@ def sigkill(h):
 
 
 def write_errors(h):
-    """An unwritable path and a full disk (a file size limit: the kernel refuses writes past it) are
-    clear errors with exit 1; what was recorded stays readable by the reference reader."""
+    """An --out in a directory that does not exist is a usage error (exit 2: checked before anything
+    starts, tools.flag_errors); a full disk (a file size limit: the kernel refuses writes past it)
+    is a clear error with exit 1; what was recorded stays readable by the reference reader."""
     status = h.run("unwritable", [h.binary("rsg_record"), "--domain", str(h.domain), "--out",
                                   str(h.dir / "no" / "such" / "dir.mcap")])
-    check(status == 1, f"rsg_record exited {status} for an unwritable path")
-    check("cannot create" in stderr_of(h, "unwritable") and "No such file or directory" in stderr_of(h, "unwritable"),
+    check(status == 2, f"rsg_record exited {status} for an --out in a missing directory")
+    check("--out" in stderr_of(h, "unwritable") and "No such file or directory" in stderr_of(h, "unwritable"),
           stderr_of(h, "unwritable"))
 
     limit = 700_000
