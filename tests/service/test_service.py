@@ -290,7 +290,8 @@ class Run:
         check(other.returncode != 0 and "Permission denied" in other.stderr,
               f"a user outside the group rsg read {STATS}: exit {other.returncode} {other.stderr!r}")
         # Documentation= names what the package installs.
-        documentation = self.box.show(UNIT, "Documentation").split()
+        # systemctl show quotes a value with parentheses ("man:rsg_gateway(1)").
+        documentation = [uri.strip('"') for uri in self.box.show(UNIT, "Documentation").split()]
         check(any(d.startswith("man:") for d in documentation) and any(d.startswith("file:") for d in documentation),
               f"Documentation= {documentation}")
         for uri in documentation:
