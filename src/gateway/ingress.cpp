@@ -32,7 +32,7 @@ Clock::time_point arrival_of(std::chrono::system_clock::time_point arrived, Cloc
 class SampleSlot {
  public:
   SampleSlot(fdds::DataWriter& writer, bool loans, RobotState& fallback)
-      : writer_(writer), sample_(&fallback) {
+      : writer_(writer), fallback_(&fallback), sample_(&fallback) {
     // No initialisation of the loan: a successful decode writes every member (header,
     // group_present and each field, absent ones zeroed; robot_state_mapping_test checks it on
     // poisoned memory), so constructing the sample first would only cost ~5 % of the gateway's
@@ -50,6 +50,16 @@ class SampleSlot {
 
   RobotState& sample() { return *sample_; }
 
+  /// Moves the sample out of its loan into the fallback and gives the loan back: the writer lends
+  /// one sample beyond its history, and another write (the held frame's) needs it first.
+  void release_loan() {
+    if (loan_ == nullptr) return;
+    *fallback_ = *sample_;
+    writer_.discard_loan(loan_);
+    loan_ = nullptr;
+    sample_ = fallback_;
+  }
+
   /// Writes the sample; a written loan belongs to the writer from then on.
   bool write() {
     const bool written = dds::succeeded(writer_.write(sample_));
@@ -60,6 +70,7 @@ class SampleSlot {
  private:
   fdds::DataWriter& writer_;
   void* loan_ = nullptr;
+  RobotState* fallback_;
   RobotState* sample_;
 };
 
@@ -189,6 +200,7 @@ void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::
 
   if (sequence_.releases_held()) {
     deliver(held_sample_, held_selection_, held_time_ms_, now);
+    slot.release_loan();
     count_write(dds::succeeded(writer_->write(&held_sample_)));  // a copy into the writer's history
   }
   deliver(slot.sample(), frame.selection(), robot_time_ms, now);
