@@ -172,6 +172,53 @@ TEST(SequenceTracker, ARestartWithoutAPauseIsBelievedOnceTheOldStreamIsSilent) {
   EXPECT_EQ(tracker.counts(), (Counts{.restarts = 1, .out_of_sequence = 8}));
 }
 
+// A robot whose selection carries `time` only in some frames (views.churn's stream: every 10th)
+// restarts after a pause: its frames without time must not keep the old stream alive, or none of
+// its frames with time would ever be published again.
+std::optional<std::uint64_t> every_tenth_has_time(std::uint64_t base_ms, std::uint64_t i) {
+  return i % 10 == 0 ? std::optional<std::uint64_t>(base_ms + i) : std::nullopt;
+}
+
+TEST(SequenceTracker, AMixedStreamRestartedWithTimeInItsFirstFrameIsARestart) {
+  Tracker tracker(100);
+  for (std::uint64_t i = 0; i < 400; ++i)
+    tracker.observe(static_cast<std::uint8_t>(i % 16), every_tenth_has_time(50'000, i));
+  tracker.wait(2000ms);
+  EXPECT_EQ(tracker.observe(0, 0), Verdict::kHeld);
+  EXPECT_EQ(tracker.observe(1, std::nullopt), Verdict::kInSequence);  // goes on from the held frame
+  EXPECT_TRUE(tracker.releases_held());
+  for (std::uint64_t i = 2; i < 400; ++i)
+    EXPECT_EQ(tracker.observe(static_cast<std::uint8_t>(i % 16), every_tenth_has_time(0, i)), Verdict::kInSequence)
+        << "frame " << i;
+  EXPECT_EQ(tracker.counts(), (Counts{.restarts = 1}));
+}
+
+TEST(SequenceTracker, AMixedStreamRestartedWithoutTimeInItsFirstFramesIsARestart) {
+  Tracker tracker(100);
+  for (std::uint64_t i = 0; i < 400; ++i)
+    tracker.observe(static_cast<std::uint8_t>(i % 16), every_tenth_has_time(50'000, i));
+  tracker.wait(2000ms);
+  std::vector<Verdict> verdicts;
+  for (std::uint64_t i = 1; i < 400; ++i)  // the first frame with time is the 10th
+    verdicts.push_back(tracker.observe(static_cast<std::uint8_t>(i % 16), every_tenth_has_time(0, i)));
+  EXPECT_EQ(verdicts[9], Verdict::kHeld);  // frame 10: its time went back while the old stream was silent
+  EXPECT_EQ(std::count(verdicts.begin(), verdicts.end(), Verdict::kInSequence), 398);
+  EXPECT_EQ(tracker.counts().restarts, 1U);
+  EXPECT_EQ(tracker.counts().out_of_sequence, 0U);
+}
+
+// While the robot's frames with time keep coming, a frame without time after a replayed one is
+// the robot's: the replay is no restart.
+TEST(SequenceTracker, AFrameWithoutTimeAfterAReplayedOneIsNoRestartWhileTheStreamIsHeard) {
+  Tracker tracker(100);
+  for (std::uint64_t i = 0; i < 400; ++i) tracker.observe_at(i, static_cast<std::uint8_t>(i % 16), 50'000 + i);
+  EXPECT_EQ(tracker.observe_at(400, 3, 1000), Verdict::kHeld);
+  EXPECT_EQ(tracker.observe_at(401, 4, std::nullopt), Verdict::kInSequence);
+  EXPECT_FALSE(tracker.releases_held());
+  EXPECT_EQ(tracker.counts().restarts, 0U);
+  EXPECT_EQ(tracker.counts().out_of_sequence, 1U);
+}
+
 // Frames lost while the new sequence waits for the old one's silence are lost in the new sequence.
 TEST(SequenceTracker, LossesWhileARestartIsConfirmedCountInTheNewSequence) {
   Tracker tracker(100);

@@ -33,6 +33,14 @@ SequenceTracker::Verdict SequenceTracker::observe(std::uint8_t packet_number,
   if (invalid_credits_ != 0 && ++frames_since_invalid_ > kModulo) invalid_credits_ = 0;
 
   const unsigned ahead = distance_ahead(newest_packet_number_, packet_number);
+  if (!time_ms && was_holding) {
+    // A frame without time that goes on from the held frame's packet number once the frames with
+    // time have been silent confirms the restart: otherwise the robot's own frames without time,
+    // which cannot be told from the old stream's, would keep that stream alive for ever.
+    const unsigned from_candidate = distance_ahead(candidate_packet_number_, packet_number);
+    if (from_candidate != 0 && from_candidate <= kMaxAheadWithoutTime && arrival - newest_time_arrival_ >= silence_)
+      return restart(from_candidate, packet_number, time_ms, arrival, true);
+  }
   // Above 1 kHz consecutive frames may share a millisecond: equal times leave it to the number.
   if (!time_ms || !newest_time_ms_ || *time_ms == *newest_time_ms_) {
     candidate_frames_ = 0;  // the stream goes on
@@ -85,8 +93,8 @@ SequenceTracker::Verdict SequenceTracker::another_sequence(std::uint8_t packet_n
   const unsigned skipped = continues ? candidate_skipped_ + ahead - 1 : 0;  // in the new sequence
   // While the stream followed so far is still heard, or the new sequence has not gone on, the
   // frame is a replay or a forgery as far as anyone can tell: it changes nothing of the stream's
-  // accounting.
-  if (arrival - newest_arrival_ < silence_ || frames < kConfirmFrames) {
+  // accounting. Only the frames with time are the stream's for sure.
+  if (arrival - newest_time_arrival_ < silence_ || frames < kConfirmFrames) {
     candidate_frames_ = frames;
     candidate_skipped_ = skipped;
     candidate_packet_number_ = packet_number;
@@ -96,17 +104,24 @@ SequenceTracker::Verdict SequenceTracker::another_sequence(std::uint8_t packet_n
     holding_ = true;
     return Verdict::kHeld;
   }
+  return restart(ahead, packet_number, time_ms, arrival, was_holding);
+}
+
+SequenceTracker::Verdict SequenceTracker::restart(unsigned ahead, std::uint8_t packet_number,
+                                                  std::optional<std::uint64_t> time_ms, Arrival arrival,
+                                                  bool release_held) noexcept {
   ++counts_.restarts;
-  // The new sequence starts at its previous frame, and what it skipped counts lost (less the
-  // invalid frames that arrived meanwhile, as in advance()).
+  // The new sequence starts at the candidate, and what its frames skipped up to it counts lost
+  // (less the invalid frames that arrived meanwhile, as in advance()).
   const std::uint64_t credits = invalid_credits_;
+  const std::uint64_t skipped = candidate_skipped_;
   start(candidate_packet_number_, candidate_time_ms_, candidate_arrival_);
-  const std::uint64_t covered = std::min<std::uint64_t>(skipped - (ahead - 1), credits);
-  counts_.lost += skipped - (ahead - 1) - covered;
+  const std::uint64_t covered = std::min(skipped, credits);
+  counts_.lost += skipped - covered;
   invalid_credits_ = credits - covered;
   advance(ahead, packet_number, time_ms, arrival);
-  releases_held_ = was_holding;
-  if (releases_held_) --counts_.out_of_sequence;  // the held frame is published after all
+  releases_held_ = release_held;
+  if (release_held) --counts_.out_of_sequence;  // the held frame is published after all
   return Verdict::kInSequence;
 }
 
