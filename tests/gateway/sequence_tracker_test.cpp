@@ -188,7 +188,8 @@ TEST(SequenceTracker, AMixedStreamRestartedWithTimeInItsFirstFrameIsARestart) {
   EXPECT_EQ(tracker.observe(1, std::nullopt), Verdict::kInSequence);  // goes on from the held frame
   EXPECT_TRUE(tracker.releases_held());
   for (std::uint64_t i = 2; i < 400; ++i)
-    EXPECT_EQ(tracker.observe(static_cast<std::uint8_t>(i % 16), every_tenth_has_time(0, i)), Verdict::kInSequence)
+    EXPECT_EQ(tracker.observe(static_cast<std::uint8_t>(i % 16), every_tenth_has_time(0, i)),
+              Verdict::kInSequence)
         << "frame " << i;
   EXPECT_EQ(tracker.counts(), (Counts{.restarts = 1}));
 }
@@ -211,7 +212,8 @@ TEST(SequenceTracker, AMixedStreamRestartedWithoutTimeInItsFirstFramesIsARestart
 // the robot's: the replay is no restart.
 TEST(SequenceTracker, AFrameWithoutTimeAfterAReplayedOneIsNoRestartWhileTheStreamIsHeard) {
   Tracker tracker(100);
-  for (std::uint64_t i = 0; i < 400; ++i) tracker.observe_at(i, static_cast<std::uint8_t>(i % 16), 50'000 + i);
+  for (std::uint64_t i = 0; i < 400; ++i)
+    tracker.observe_at(i, static_cast<std::uint8_t>(i % 16), 50'000 + i);
   EXPECT_EQ(tracker.observe_at(400, 3, 1000), Verdict::kHeld);
   EXPECT_EQ(tracker.observe_at(401, 4, std::nullopt), Verdict::kInSequence);
   EXPECT_FALSE(tracker.releases_held());

@@ -38,7 +38,8 @@ SequenceTracker::Verdict SequenceTracker::observe(std::uint8_t packet_number,
     // time have been silent confirms the restart: otherwise the robot's own frames without time,
     // which cannot be told from the old stream's, would keep that stream alive for ever.
     const unsigned from_candidate = distance_ahead(candidate_packet_number_, packet_number);
-    if (from_candidate != 0 && from_candidate <= kMaxAheadWithoutTime && arrival - newest_time_arrival_ >= silence_)
+    if (from_candidate != 0 && from_candidate <= kMaxAheadWithoutTime &&
+        arrival - newest_time_arrival_ >= silence_)
       return restart(from_candidate, packet_number, time_ms, arrival, true);
   }
   // Above 1 kHz consecutive frames may share a millisecond: equal times leave it to the number.

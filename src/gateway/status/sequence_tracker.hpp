@@ -36,14 +36,15 @@
 // stream followed so far has been silent for `silence` (what takes the link down, link_monitor.hpp).
 // The frame of the new sequence before the one that confirms it is held (observe() says kHeld) and
 // published first once the restart is believed, so a robot that reboots after a pause loses no
-// frame. Only frames with `time` are surely the stream's: in a stream where some frames carry no
-// time, the silence is that of the frames with time, and a frame without time that goes on from
-// the held frame's packet number confirms the restart as well. A replayed or forged frame interleaved with the robot's stream therefore never counts as a
-// restart, nor shifts the packet numbers the stream's losses are counted from; only a sender that
-// outlasts the robot's own silence can start a new sequence. A robot that starts a new sequence
-// without a pause has its first frames counted out_of_sequence until its old stream has been
-// silent for that long. Frames without `time` cannot be told apart this way: every one is
-// published and only the packet-number rules above apply.
+// frame. A replayed or forged frame interleaved with the robot's stream therefore never counts as
+// a restart, nor shifts the packet numbers the stream's losses are counted from; only a sender
+// that outlasts the robot's own silence can start a new sequence. A robot that starts a new
+// sequence without a pause has its first frames counted out_of_sequence until its old stream has
+// been silent for that long. Frames without `time` cannot be told apart this way: every one is
+// published and only the packet-number rules above apply. So only frames with `time` are surely
+// the stream's: in a stream where some frames carry none, the silence is that of the frames with
+// time, and a frame without time that goes on from the held frame's packet number confirms the
+// restart as well.
 //
 // An invalid frame (rejected by the decoder, so its packet number cannot be trusted) is counted
 // under its category, not as lost: `on_invalid()` notes it, and the next gaps ahead absorb one
@@ -112,8 +113,8 @@ class SequenceTracker {
                Arrival arrival) noexcept;
   Verdict another_sequence(std::uint8_t packet_number, std::uint64_t time_ms, Arrival arrival,
                            bool was_holding) noexcept;
-  Verdict restart(unsigned ahead, std::uint8_t packet_number, std::optional<std::uint64_t> time_ms, Arrival arrival,
-                  bool release_held) noexcept;
+  Verdict restart(unsigned ahead, std::uint8_t packet_number, std::optional<std::uint64_t> time_ms,
+                  Arrival arrival, bool release_held) noexcept;
   bool in_step(std::uint64_t from_ms, Arrival from_arrival, std::uint64_t to_ms,
                Arrival to_arrival) const noexcept;
   void arrive_late(unsigned age) noexcept;
