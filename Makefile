@@ -178,7 +178,7 @@ test-fastdds3: build-tests
 # CMAKE_PREFIX_PATH, and across versions with $(BUILD)'s 2.9.1 (tests/fastdds214/run.sh,
 # docs/fastdds-versions.md). Its own tree, build-fdds214/.
 .PHONY: test-fastdds214
-test-fastdds214: build
+test-fastdds214: build-tests
 	JOBS=$(JOBS) DEPS_DIR=$(DEPS_DIR) tests/fastdds214/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds214.log
 
 # make bench's e2e suite on 2.9 (host) and 3.x (chroot) back to back, side by side (docs/benchmarks/fastdds3/).

@@ -11,7 +11,8 @@
 #    on CMAKE_PREFIX_PATH and LD_LIBRARY_PATH, as Jazzy's setup.bash puts it: the targets of the
 #    tests below only;
 # 3. runs there the unit tests, the views (content filters included), the pipeline, the embedded
-#    gateway and the installed package's consumers;
+#    gateway, the installed package's consumers, and the gateway inside a ROS 2 Jazzy node
+#    (examples/ros2_node, built in make deps' Jazzy environment: tests/ros2/test_ros2_node.py);
 # 4. compares rsg_type_dump of both builds (sample bytes, largest sizes, TypeObject identifiers),
 #    then runs views and the pipeline with the processes of one side from each build.
 # Closes with its time and one line "test-fastdds214: N passed, N failed".
@@ -78,6 +79,11 @@ count_ctest "$logs/unit.log"
    ctest --output-on-failure -j "$((jobs + 1))" -R "^($processes)\$") > "$logs/processes.log" 2>&1
 grep -E '^ *[0-9]+/[0-9]+ Test|tests passed' "$logs/processes.log"
 count_ctest "$logs/processes.log"
+
+# The gateway inside a ROS 2 Jazzy node (examples/ros2_node): rsg installed from this build, the
+# example built in make deps' Jazzy environment against it, one Fast DDS in the process, read by a
+# Jazzy rclpy subscription.
+check ros2_node_jazzy python3 tests/ros2/test_ros2_node.py --bin "$build/bin"
 
 # 4. Against 2.9.
 if [[ ! -x $host_build/bin/rsg_type_dump || ! -x $host_build/bin/rsg_views_publish ]]; then
