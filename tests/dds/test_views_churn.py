@@ -20,7 +20,6 @@ longest ingress delay are printed, not judged (timings belong in make bench).
 import json
 import os
 import signal
-import subprocess
 import sys
 import threading
 import time
@@ -28,7 +27,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "ros2"))
-from harness import check, free_udp_port, main, read_json, read_json_lines, wait_for, wait_for_stats  # noqa: E402
+from harness import (check, free_udp_port, main, read_json, read_json_lines, realtime_prefix, wait_for,  # noqa: E402
+                     wait_for_stats)
 from rclpy_common import RosEnv, read_messages, start_peer, wait_peer_matched  # noqa: E402
 from test_rclpy_state import check_in_order  # noqa: E402
 
@@ -64,12 +64,6 @@ def stop_child(process, index):
     except Exception:  # noqa: a reader that ignores SIGTERM is not what this test is about
         process.kill()
         process.wait()
-
-
-def realtime_prefix():
-    """`chrt -f 20` when the kernel lets this process use SCHED_FIFO, else nothing."""
-    probe = subprocess.run(["chrt", "-f", "20", "true"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return ["chrt", "-f", "20"] if probe.returncode == 0 else []
 
 
 def body(h):

@@ -65,6 +65,13 @@ def wait_matched(h, stats, labels, tool):
         wait_reader_matched(h, label, tool)
 
 
+def realtime_prefix():
+    """`chrt -f 20` when the kernel lets this process use SCHED_FIFO, else nothing: for a robot
+    (rsg_sim) that must stream on time while the tests beside it load the cores."""
+    probe = subprocess.run(["chrt", "-f", "20", "true"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return ["chrt", "-f", "20"] if probe.returncode == 0 else []
+
+
 def free_udp_port():
     """A port no one is bound to right now (the kernel's pick for port 0)."""
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:

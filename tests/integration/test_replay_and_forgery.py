@@ -15,8 +15,8 @@ import sys
 import time
 import zlib
 
-from harness import (check, free_udp_port, main, read_json, read_json_lines, wait_for, wait_for_stats,
-                     wait_reader_matched)
+from harness import (check, free_udp_port, main, read_json, read_json_lines, realtime_prefix, wait_for,
+                     wait_for_stats, wait_reader_matched)
 
 RATE = 1000
 COUNT = 3000  # 3 s of the robot's stream
@@ -60,7 +60,9 @@ def body(h):
     wait_reader_matched(h, "slow", "rsg_echo")
 
     record, report_path = h.dir / "robot.record.jsonl", h.dir / "robot.report.json"
-    robot = h.start("robot", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", str(RATE), "--count",
+    # The robot streams on time (SCHED_FIFO when allowed): a stall of its own longer than the silence
+    # limit is exactly when a replayed frame may start a new sequence (docs/operating.md).
+    robot = h.start("robot", [*realtime_prefix(), h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", str(RATE), "--count",
                               str(COUNT), "--fields", "q,time", "--record", str(record), "--report", str(report_path)])
     # Once the robot's time is well past the capture's, and while it streams: the replay, then the forger.
     wait_for_stats(stats, lambda s: s["frames_published"] >= 500, "the robot's stream to be under way")

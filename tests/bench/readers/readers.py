@@ -38,7 +38,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1] / "integration"))
 sys.path.insert(0, str(HERE.parents[1] / "ros2"))
-from harness import acquire_domain, free_udp_port, read_json, wait_for  # noqa: E402
+from harness import acquire_domain, free_udp_port, read_json, realtime_prefix, wait_for  # noqa: E402
 from test_domain import release_domain  # noqa: E402  (tests/support, on the path through harness)
 
 TICKS = os.sysconf("SC_CLK_TCK")
@@ -60,11 +60,6 @@ def tree_ticks(pid):
     except (FileNotFoundError, ProcessLookupError):
         pass
     return total
-
-
-def realtime_prefix():
-    probe = subprocess.run(["chrt", "-f", "20", "true"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return ["chrt", "-f", "20"] if probe.returncode == 0 else []
 
 
 def terminate(*processes, timeout_s=10):
