@@ -17,11 +17,16 @@ GatewayStats distinct_stats() {
   stats.ingress.publish_failed = 3;
   for (std::size_t i = 0; i < stats.ingress.invalid.size(); ++i) stats.ingress.invalid[i] = 100 + i;
   stats.ingress.rejected_source = 4;
-  stats.sequence = {.lost = 5, .duplicated = 6, .reordered = 7, .restarts = 8};
+  stats.sequence = {.lost = 5, .duplicated = 6, .reordered = 7, .restarts = 8, .out_of_sequence = 19};
   stats.state_readers = 13;
   stats.egress_writers = 14;
   stats.standard_readers = 16;
-  stats.egress = {.samples = 9, .frames_sent = 10, .unencodable = 11, .send_failed = 12};
+  stats.egress = {.samples = 9,
+                  .frames_sent = 10,
+                  .unencodable = 11,
+                  .send_failed = 12,
+                  .request_like = 20,
+                  .rate_limited = 21};
   stats.standard_dropped = 15;
   stats.ingress_delay_us = 17;
   stats.ingress_delay_max_us = 18;
@@ -57,6 +62,7 @@ TEST(StatusSample, CountersAndLinkStateAreCopied) {
   EXPECT_EQ(sample.duplicated(), 6U);
   EXPECT_EQ(sample.reordered(), 7U);
   EXPECT_EQ(sample.robot_restarts(), 8U);
+  EXPECT_EQ(sample.out_of_sequence(), 19U);
   EXPECT_EQ(sample.state_readers(), 13U);
   EXPECT_EQ(sample.egress_writers(), 14U);
   EXPECT_EQ(sample.standard_readers(), 16U);
@@ -64,6 +70,8 @@ TEST(StatusSample, CountersAndLinkStateAreCopied) {
   EXPECT_EQ(sample.egress_frames_sent(), 10U);
   EXPECT_EQ(sample.egress_unencodable(), 11U);
   EXPECT_EQ(sample.egress_send_failed(), 12U);
+  EXPECT_EQ(sample.egress_request_like(), 20U);
+  EXPECT_EQ(sample.egress_rate_limited(), 21U);
   EXPECT_EQ(sample.standard_dropped(), 15U);
 }
 

@@ -35,6 +35,7 @@ void to_status_sample(const GatewayStats& stats, GatewayStatus& sample) {
   sample.duplicated(stats.sequence.duplicated);
   sample.reordered(stats.sequence.reordered);
   sample.robot_restarts(stats.sequence.restarts);
+  sample.out_of_sequence(stats.sequence.out_of_sequence);
   sample.state_readers(stats.state_readers);
   sample.egress_writers(stats.egress_writers);
   sample.standard_readers(stats.standard_readers);
@@ -42,6 +43,8 @@ void to_status_sample(const GatewayStats& stats, GatewayStatus& sample) {
   sample.egress_frames_sent(stats.egress.frames_sent);
   sample.egress_unencodable(stats.egress.unencodable);
   sample.egress_send_failed(stats.egress.send_failed);
+  sample.egress_request_like(stats.egress.request_like);
+  sample.egress_rate_limited(stats.egress.rate_limited);
   sample.standard_dropped(stats.standard_dropped);
   sample.ingress_delay_us(stats.ingress_delay_us);
   sample.ingress_delay_max_us(stats.ingress_delay_max_us);
@@ -60,14 +63,17 @@ GatewayStats from_status_sample(const GatewayStatus& sample) {
   stats.sequence = {.lost = sample.lost(),
                     .duplicated = sample.duplicated(),
                     .reordered = sample.reordered(),
-                    .restarts = sample.robot_restarts()};
+                    .restarts = sample.robot_restarts(),
+                    .out_of_sequence = sample.out_of_sequence()};
   stats.state_readers = sample.state_readers();
   stats.egress_writers = sample.egress_writers();
   stats.standard_readers = sample.standard_readers();
   stats.egress = {.samples = sample.egress_samples(),
                   .frames_sent = sample.egress_frames_sent(),
                   .unencodable = sample.egress_unencodable(),
-                  .send_failed = sample.egress_send_failed()};
+                  .send_failed = sample.egress_send_failed(),
+                  .request_like = sample.egress_request_like(),
+                  .rate_limited = sample.egress_rate_limited()};
   stats.standard_dropped = sample.standard_dropped();
   stats.ingress_delay_us = sample.ingress_delay_us();
   stats.ingress_delay_max_us = sample.ingress_delay_max_us();

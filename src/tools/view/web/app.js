@@ -83,6 +83,7 @@ function onStatus(g) {
   $("lost").textContent = g.lost;
   $("duplicated").textContent = g.duplicated;
   $("reordered").textContent = g.reordered;
+  $("out-of-sequence").textContent = g.out_of_sequence ?? "–";
   $("standard-dropped").textContent = g.standard_dropped ?? "–";
   const invalid = Object.entries(g.invalid || {}).filter(([, n]) => n > 0);
   $("invalid").textContent = invalid.length === 0 ? "0" : invalid.map(([k, n]) => `${k}=${n}`).join(" ");
