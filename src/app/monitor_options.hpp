@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "dds_options.hpp"
-#include "discovery_cli.hpp"
-#include "monitor_readers.hpp"
+#include "app/dds_options.hpp"
+#include "app/discovery_cli.hpp"
+#include "app/monitor_readers.hpp"
 #include "rsg/dds/discovery.hpp"
 #include "rsg/dds/profiles.hpp"
 

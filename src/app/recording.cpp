@@ -1,4 +1,4 @@
-#include "recording.hpp"
+#include "app/recording.hpp"
 
 #include <GatewayStatusPubSubTypes.h>
 #include <RobotStatePubSubTypes.h>
@@ -6,8 +6,8 @@
 
 #include <cstring>
 
+#include "app/recording_schemas.hpp"
 #include "dds/internal/fastdds_compat.hpp"
-#include "recording_schemas.hpp"
 
 namespace rsg::app {
 namespace {

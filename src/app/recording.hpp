@@ -19,7 +19,7 @@
 #include <utility>
 #include <vector>
 
-#include "mcap_writer.hpp"
+#include "mcap/mcap_writer.hpp"
 
 namespace rsg::app {
 

@@ -1,4 +1,4 @@
-#include "recording_order.hpp"
+#include "app/recording_order.hpp"
 
 #include <algorithm>
 #include <utility>

@@ -27,7 +27,7 @@
 #include <string_view>
 #include <utility>
 
-#include "exit_status.hpp"
+#include "app/exit_status.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::app {

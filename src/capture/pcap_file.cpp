@@ -1,4 +1,4 @@
-#include "pcap_file.hpp"
+#include "capture/pcap_file.hpp"
 
 #include <pcap/pcap.h>
 

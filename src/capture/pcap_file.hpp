@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "udp_packet.hpp"
+#include "capture/udp_packet.hpp"
 
 struct pcap;
 struct pcap_dumper;

@@ -1,4 +1,4 @@
-#include "udp_packet.hpp"
+#include "capture/udp_packet.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>

@@ -1,4 +1,4 @@
-#include "foxglove_protocol.hpp"
+#include "foxglove/foxglove_protocol.hpp"
 
 #include <limits>
 #include <nlohmann/json.hpp>

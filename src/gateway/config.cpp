@@ -1,4 +1,4 @@
-#include "config.hpp"
+#include "gateway/config.hpp"
 
 #include <fmt/format.h>
 #include <sched.h>
@@ -10,11 +10,11 @@
 #include <charconv>
 #include <set>
 
+#include "gateway/source_filter.hpp"
 #include "rsg/dds/ros2.hpp"
 #include "rsg/transport/host_port.hpp"
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/number.hpp"
-#include "source_filter.hpp"
 
 namespace rsg::gateway {
 namespace {

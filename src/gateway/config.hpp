@@ -16,7 +16,7 @@
 #include <variant>
 #include <vector>
 
-#include "decimator.hpp"
+#include "gateway/decimator.hpp"
 #include "rsg/wire/selection.hpp"
 
 namespace rsg::gateway {

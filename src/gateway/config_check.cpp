@@ -1,9 +1,9 @@
-#include "config_check.hpp"
+#include "gateway/config_check.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "dds_options.hpp"
+#include "app/dds_options.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/wire/frame.hpp"
 

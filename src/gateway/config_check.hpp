@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "config.hpp"
-#include "gateway.hpp"
+#include "gateway/config.hpp"
+#include "gateway/gateway.hpp"
 
 namespace rsg::gateway {
 

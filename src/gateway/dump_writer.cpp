@@ -1,4 +1,4 @@
-#include "dump_writer.hpp"
+#include "gateway/dump_writer.hpp"
 
 #include <pthread.h>
 #include <spdlog/spdlog.h>

@@ -17,9 +17,9 @@
 #include <string>
 #include <thread>
 
-#include "clock.hpp"
-#include "flight_recorder.hpp"
-#include "log_throttle.hpp"
+#include "gateway/clock.hpp"
+#include "gateway/flight_recorder.hpp"
+#include "gateway/log_throttle.hpp"
 
 namespace rsg::gateway {
 

@@ -1,4 +1,4 @@
-#include "egress.hpp"
+#include "gateway/egress.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -6,7 +6,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <stdexcept>
 
-#include "ros2_type_hash.hpp"
+#include "gateway/ros2_type_hash.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/error.hpp"
 

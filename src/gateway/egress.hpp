@@ -22,14 +22,14 @@
 #include <thread>
 #include <vector>
 
-#include "clock.hpp"
-#include "log_throttle.hpp"
+#include "gateway/clock.hpp"
+#include "gateway/log_throttle.hpp"
+#include "gateway/status/stats.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/transport/udp_socket.hpp"
 #include "rsg/wire/frame.hpp"
-#include "stats.hpp"
 
 namespace rsg::gateway {
 

@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <thread>
 
-#include "config.hpp"
-#include "gateway.hpp"
+#include "gateway/config.hpp"
+#include "gateway/gateway.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::gateway {

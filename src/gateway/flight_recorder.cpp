@@ -1,11 +1,11 @@
-#include "flight_recorder.hpp"
+#include "gateway/flight_recorder.hpp"
 
 #include <cmath>
 #include <cstring>
 #include <ctime>
 #include <stdexcept>
 
-#include "pcap_file.hpp"
+#include "capture/pcap_file.hpp"
 
 namespace rsg::gateway {
 namespace {

@@ -19,9 +19,9 @@
 #include <string_view>
 #include <vector>
 
+#include "capture/udp_packet.hpp"
+#include "gateway/source_filter.hpp"
 #include "rsg/transport/udp_socket.hpp"
-#include "source_filter.hpp"
-#include "udp_packet.hpp"
 
 namespace rsg::gateway {
 

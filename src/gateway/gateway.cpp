@@ -1,4 +1,4 @@
-#include "gateway.hpp"
+#include "gateway/gateway.hpp"
 
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
@@ -14,16 +14,16 @@
 #include <thread>
 #include <utility>
 
-#include "credentials.hpp"
-#include "errno_text.hpp"
-#include "realtime.hpp"
+#include "gateway/credentials.hpp"
+#include "gateway/errno_text.hpp"
+#include "gateway/realtime.hpp"
+#include "gateway/version.hpp"
 #include "rsg/dds/discovery.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/ros2.hpp"
 #include "rsg/error.hpp"
-#include "version.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;

@@ -11,17 +11,17 @@
 #include <string>
 #include <variant>
 
-#include "config.hpp"
-#include "dump_writer.hpp"
-#include "egress.hpp"
-#include "ingress.hpp"
-#include "link_monitor.hpp"
-#include "log_throttle.hpp"
-#include "loop_observer.hpp"
-#include "metrics_server.hpp"
-#include "no_link_warning.hpp"
-#include "stats_file.hpp"
-#include "status_publisher.hpp"
+#include "gateway/config.hpp"
+#include "gateway/dump_writer.hpp"
+#include "gateway/egress.hpp"
+#include "gateway/ingress.hpp"
+#include "gateway/link_monitor.hpp"
+#include "gateway/log_throttle.hpp"
+#include "gateway/loop_observer.hpp"
+#include "gateway/metrics_server.hpp"
+#include "gateway/no_link_warning.hpp"
+#include "gateway/stats_file.hpp"
+#include "gateway/status_publisher.hpp"
 
 namespace rsg::gateway {
 

@@ -1,4 +1,4 @@
-#include "ingress.hpp"
+#include "gateway/ingress.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "dds/internal/fastdds_compat.hpp"  // is_plain
-#include "ros2_type_hash.hpp"
+#include "gateway/ros2_type_hash.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::gateway {

@@ -15,21 +15,21 @@
 #include <string>
 #include <vector>
 
-#include "clock.hpp"
-#include "decimator.hpp"
-#include "flight_recorder.hpp"
-#include "latency_histogram.hpp"
-#include "link_monitor.hpp"
-#include "ros2_standard_topics.hpp"
+#include "gateway/clock.hpp"
+#include "gateway/decimator.hpp"
+#include "gateway/flight_recorder.hpp"
+#include "gateway/latency_histogram.hpp"
+#include "gateway/link_monitor.hpp"
+#include "gateway/ros2_standard_topics.hpp"
+#include "gateway/selection_requester.hpp"
+#include "gateway/source_filter.hpp"
+#include "gateway/status/sequence_tracker.hpp"
+#include "gateway/status/stats.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/transport/udp_socket.hpp"
 #include "rsg/wire/frame.hpp"
-#include "selection_requester.hpp"
-#include "sequence_tracker.hpp"
-#include "source_filter.hpp"
-#include "stats.hpp"
 
 namespace rsg::gateway {
 

@@ -1,4 +1,4 @@
-#include "journal_log.hpp"
+#include "gateway/journal_log.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/details/log_msg.h>

@@ -11,7 +11,7 @@
 #include <chrono>
 #include <cstdint>
 
-#include "clock.hpp"
+#include "gateway/clock.hpp"
 
 namespace rsg::gateway {
 

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "clock.hpp"
+#include "gateway/clock.hpp"
 
 namespace rsg::gateway {
 

@@ -3,8 +3,8 @@
 // stops calling: that is what a watchdog needs.
 #pragma once
 
-#include "clock.hpp"
-#include "stats.hpp"
+#include "gateway/clock.hpp"
+#include "gateway/status/stats.hpp"
 
 namespace rsg::gateway {
 

@@ -19,16 +19,16 @@
 #include <sstream>
 #include <string>
 
-#include "config.hpp"
-#include "config_check.hpp"
-#include "errno_text.hpp"
-#include "gateway.hpp"
-#include "journal_log.hpp"
+#include "app/stop_on_signal.hpp"
+#include "app/tool_main.hpp"
+#include "gateway/config.hpp"
+#include "gateway/config_check.hpp"
+#include "gateway/errno_text.hpp"
+#include "gateway/gateway.hpp"
+#include "gateway/journal_log.hpp"
+#include "gateway/service_notifier.hpp"
+#include "gateway/version.hpp"
 #include "rsg/error.hpp"
-#include "service_notifier.hpp"
-#include "stop_on_signal.hpp"
-#include "tool_main.hpp"
-#include "version.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "metrics.hpp"
+#include "gateway/metrics.hpp"
 
 #include <dirent.h>
 #include <fmt/format.h>

@@ -11,9 +11,9 @@
 #include <string_view>
 #include <vector>
 
-#include "clock.hpp"
-#include "latency_histogram.hpp"
-#include "stats.hpp"
+#include "gateway/clock.hpp"
+#include "gateway/latency_histogram.hpp"
+#include "gateway/status/stats.hpp"
 
 namespace rsg::gateway {
 

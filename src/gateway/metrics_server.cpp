@@ -1,4 +1,4 @@
-#include "metrics_server.hpp"
+#include "gateway/metrics_server.hpp"
 
 #include <fmt/format.h>
 #include <pthread.h>
@@ -15,10 +15,10 @@
 #include <optional>
 #include <thread>
 
-#include "http_reply.hpp"
-#include "log_throttle.hpp"
+#include "app/http_reply.hpp"
+#include "app/tcp_listener.hpp"
+#include "gateway/log_throttle.hpp"
 #include "rsg/error.hpp"
-#include "tcp_listener.hpp"
 
 namespace rsg::gateway {
 namespace {

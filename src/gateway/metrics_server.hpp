@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "metrics.hpp"
+#include "gateway/metrics.hpp"
 #include "rsg/transport/udp_socket.hpp"
 
 namespace rsg::gateway {

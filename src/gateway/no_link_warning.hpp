@@ -10,8 +10,8 @@
 #include <optional>
 #include <string>
 
-#include "clock.hpp"
-#include "stats.hpp"
+#include "gateway/clock.hpp"
+#include "gateway/status/stats.hpp"
 
 namespace rsg::gateway {
 

@@ -1,4 +1,4 @@
-#include "realtime.hpp"
+#include "gateway/realtime.hpp"
 
 #include <pthread.h>
 #include <sched.h>

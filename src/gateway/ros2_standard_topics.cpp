@@ -1,4 +1,4 @@
-#include "ros2_standard_topics.hpp"
+#include "gateway/ros2_standard_topics.hpp"
 
 #include <StandardMessages.h>
 #include <StandardMessagesPubSubTypes.h>
@@ -8,7 +8,7 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <stdexcept>
 
-#include "ros2_type_hash.hpp"
+#include "gateway/ros2_type_hash.hpp"
 #include "rsg/error.hpp"
 #include "rsg/wire/eigen.hpp"
 

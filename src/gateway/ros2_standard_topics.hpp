@@ -20,7 +20,7 @@
 #include <thread>
 #include <vector>
 
-#include "decimator.hpp"
+#include "gateway/decimator.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"

@@ -14,9 +14,9 @@
 #include <string_view>
 #include <vector>
 
+#include "gateway/ros2_type_hashes.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/views.hpp"
-#include "rsg_ros2_type_hashes.hpp"
 
 namespace rsg::gateway {
 

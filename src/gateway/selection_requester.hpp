@@ -12,7 +12,7 @@
 
 #include <string>
 
-#include "clock.hpp"
+#include "gateway/clock.hpp"
 #include "rsg/wire/selection.hpp"
 
 namespace rsg::gateway {

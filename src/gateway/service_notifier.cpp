@@ -1,4 +1,4 @@
-#include "service_notifier.hpp"
+#include "gateway/service_notifier.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>

@@ -13,9 +13,9 @@
 #include <string>
 #include <string_view>
 
-#include "clock.hpp"
-#include "loop_observer.hpp"
-#include "stats.hpp"
+#include "gateway/clock.hpp"
+#include "gateway/loop_observer.hpp"
+#include "gateway/status/stats.hpp"
 
 namespace rsg::gateway {
 

@@ -1,4 +1,4 @@
-#include "stats_file.hpp"
+#include "gateway/stats_file.hpp"
 
 #include <pthread.h>
 #include <spdlog/spdlog.h>
@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <utility>
 
-#include "errno_text.hpp"
+#include "gateway/errno_text.hpp"
 
 namespace rsg::gateway {
 

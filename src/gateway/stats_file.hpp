@@ -9,7 +9,7 @@
 #include <string>
 #include <thread>
 
-#include "stats.hpp"
+#include "gateway/status/stats.hpp"
 
 namespace rsg::gateway {
 

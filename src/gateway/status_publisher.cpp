@@ -1,4 +1,4 @@
-#include "status_publisher.hpp"
+#include "gateway/status_publisher.hpp"
 
 #include <GatewayStatusPubSubTypes.h>
 #include <spdlog/spdlog.h>
@@ -7,9 +7,9 @@
 #include <stdexcept>
 
 #include "dds/internal/fastdds_compat.hpp"  // rename_type
-#include "ros2_type_hash.hpp"
+#include "gateway/ros2_type_hash.hpp"
+#include "gateway/status/status_sample.hpp"
 #include "rsg/error.hpp"
-#include "status_sample.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;

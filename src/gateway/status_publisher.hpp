@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "gateway/status/stats.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
-#include "stats.hpp"
 
 namespace rsg::gateway {
 

@@ -1,4 +1,4 @@
-#include "version.hpp"
+#include "gateway/version.hpp"
 
 namespace rsg::gateway {
 

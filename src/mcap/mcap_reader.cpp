@@ -1,4 +1,4 @@
-#include "mcap_reader.hpp"
+#include "mcap/mcap_reader.hpp"
 
 #include <fcntl.h>
 #include <isa-l/crc.h>

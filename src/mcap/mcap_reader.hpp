@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "mcap_records.hpp"
+#include "mcap/mcap_records.hpp"
 
 namespace rsg::mcap {
 

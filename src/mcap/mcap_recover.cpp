@@ -1,4 +1,4 @@
-#include "mcap_recover.hpp"
+#include "mcap/mcap_recover.hpp"
 
 #include <map>
 #include <optional>

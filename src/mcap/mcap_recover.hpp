@@ -11,8 +11,8 @@
 #include <filesystem>
 #include <span>
 
-#include "mcap_reader.hpp"
-#include "mcap_writer.hpp"
+#include "mcap/mcap_reader.hpp"
+#include "mcap/mcap_writer.hpp"
 
 namespace rsg::mcap {
 

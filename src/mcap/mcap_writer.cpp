@@ -1,4 +1,4 @@
-#include "mcap_writer.hpp"
+#include "mcap/mcap_writer.hpp"
 
 #include <fcntl.h>
 #include <isa-l/crc.h>

@@ -25,7 +25,7 @@
 #include <utility>
 #include <vector>
 
-#include "mcap_records.hpp"
+#include "mcap/mcap_records.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::mcap {

@@ -1,4 +1,4 @@
-#include "crc32_copy.hpp"
+#include "wire/crc32_copy.hpp"
 
 #include <immintrin.h>
 

@@ -2,9 +2,9 @@
 
 #include <cstring>
 
-#include "crc32_copy.hpp"
-#include "frame_checks.hpp"
 #include "rsg/wire/crc32.hpp"
+#include "wire/crc32_copy.hpp"
+#include "wire/frame_checks.hpp"
 
 namespace rsg::wire {
 

@@ -10,10 +10,10 @@
 #include <span>
 #include <utility>
 
-#include "group_bytes.hpp"
 #include "rsg/wire/detail/copy_plan.hpp"
 #include "rsg/wire/error_flags.hpp"
 #include "rsg/wire/frame.hpp"
+#include "wire/group_bytes.hpp"
 
 namespace rsg::wire::detail {
 

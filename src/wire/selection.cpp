@@ -3,9 +3,9 @@
 #include <string>
 #include <utility>
 
-#include "group_bytes.hpp"
 #include "rsg/wire/number.hpp"
 #include "rsg/wire/text.hpp"
+#include "wire/group_bytes.hpp"
 
 namespace rsg::wire {
 namespace {

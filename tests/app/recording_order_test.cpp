@@ -1,6 +1,6 @@
 // PublicationOrder: what rsg_record writes is each writer's samples in sequence order, whatever order
 // they arrived in, and the counts say what could not be placed.
-#include "recording_order.hpp"
+#include "app/recording_order.hpp"
 
 #include <gtest/gtest.h>
 

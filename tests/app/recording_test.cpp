@@ -1,16 +1,16 @@
 // The recording's schemas are the project's IDL files byte for byte, and a recorded payload is
 // what Fast DDS itself puts on the wire; every conformance vector survives frame -> sample -> CDR
 // -> sample -> frame unchanged (what rsg_replay relies on for byte-identical frames).
-#include "recording.hpp"
+#include "app/recording.hpp"
 
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <iterator>
 
-#include "recording_schemas.hpp"
+#include "app/recording_schemas.hpp"
 #include "rsg/dds/robot_state.hpp"
-#include "vectors.hpp"
+#include "tests/support/vectors.hpp"
 
 namespace rsg::app {
 namespace {

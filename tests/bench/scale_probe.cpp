@@ -30,13 +30,13 @@
 #include <iostream>
 #include <vector>
 
-#include "discovery_cli.hpp"
-#include "e2e/stamped_frames.hpp"
+#include "app/discovery_cli.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
 #include "rsg/transport/udp_socket.hpp"
+#include "tests/bench/e2e/stamped_frames.hpp"
 
 namespace {
 

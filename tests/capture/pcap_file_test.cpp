@@ -1,7 +1,7 @@
 // PcapWriter and PcapReader: what one writes the other reads back (pcap), a pcapng file of the same
 // datagrams reads the same, and a file cut anywhere reads its whole packets and then ends (cut
 // between two packets) or throws rsg::InputError (cut inside one), never a wrong datagram.
-#include "pcap_file.hpp"
+#include "capture/pcap_file.hpp"
 
 #include <gtest/gtest.h>
 #include <pcap/pcap.h>
@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "capture/udp_packet.hpp"
 #include "rsg/error.hpp"
-#include "udp_packet.hpp"
 
 namespace rsg::capture {
 namespace {

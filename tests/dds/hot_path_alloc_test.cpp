@@ -14,14 +14,14 @@
 #include <random>
 #include <thread>
 
-#include "allocation_counter.hpp"
 #include "dds/internal/fastdds_compat.hpp"
-#include "random_state.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/wire/frame.hpp"
-#include "test_domain.hpp"
+#include "tests/support/allocation_counter.hpp"
+#include "tests/support/random_state.hpp"
+#include "tests/support/test_domain.hpp"
 
 namespace rsg {
 namespace fdds = eprosima::fastdds::dds;

@@ -8,10 +8,10 @@
 #include <random>
 #include <vector>
 
-#include "random_state.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/state_values.hpp"
+#include "tests/support/random_state.hpp"
 
 namespace rsg::test {
 

@@ -14,11 +14,11 @@
 #include <string>
 #include <thread>
 
-#include "mixed_stream.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/wire/json.hpp"
+#include "tests/dds/mixed_stream.hpp"
 
 namespace fdds = eprosima::fastdds::dds;
 

@@ -8,7 +8,7 @@
 
 #include "dds/internal/fastdds_compat.hpp"
 #include "rsg/dds/robot_state.hpp"
-#include "vectors.hpp"
+#include "tests/support/vectors.hpp"
 
 namespace rsg {
 namespace {

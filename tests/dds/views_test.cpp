@@ -13,11 +13,11 @@
 #include <map>
 #include <memory>
 
-#include "mixed_stream.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
-#include "test_domain.hpp"
+#include "tests/dds/mixed_stream.hpp"
+#include "tests/support/test_domain.hpp"
 
 namespace rsg {
 namespace fdds = eprosima::fastdds::dds;

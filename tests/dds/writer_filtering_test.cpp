@@ -18,14 +18,14 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
 #include "dds/internal/fastdds_compat.hpp"  // disable_intraprocess_delivery
-#include "mixed_stream.hpp"
 #include "rsg/dds/group_filter.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/dds/views.hpp"
-#include "sent_data_recorder.hpp"
-#include "test_domain.hpp"
+#include "tests/dds/mixed_stream.hpp"
+#include "tests/dds/sent_data_recorder.hpp"
+#include "tests/support/test_domain.hpp"
 
 namespace rsg {
 namespace fdds = eprosima::fastdds::dds;

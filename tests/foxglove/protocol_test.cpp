@@ -3,7 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "foxglove_protocol.hpp"
+#include "foxglove/foxglove_protocol.hpp"
 
 namespace rsg::foxglove {
 namespace {

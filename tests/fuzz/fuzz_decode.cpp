@@ -6,11 +6,11 @@
 #include <cstdint>
 #include <span>
 
-#include "fuzz_check.hpp"
 #include "rsg/wire/deframer.hpp"
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/frame_codec.hpp"
 #include "rsg/wire/state_values.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::span<const std::uint8_t> bytes(data, size);

@@ -14,8 +14,8 @@
 #include <span>
 #include <vector>
 
-#include "fuzz_check.hpp"
 #include "rsg/wire/deframer.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
 
 namespace {
 

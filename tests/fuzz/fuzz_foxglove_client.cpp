@@ -5,8 +5,8 @@
 #include <string_view>
 #include <variant>
 
-#include "foxglove_protocol.hpp"
-#include "fuzz_check.hpp"
+#include "foxglove/foxglove_protocol.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace rsg::foxglove;

@@ -9,8 +9,8 @@
 #include <string>
 #include <string_view>
 
-#include "fuzz_check.hpp"
 #include "rsg/dds/group_filter.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::span<const std::uint8_t> bytes(data, size);

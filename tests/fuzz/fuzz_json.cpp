@@ -5,10 +5,10 @@
 #include <string>
 #include <string_view>
 
-#include "fuzz_check.hpp"
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/json.hpp"
 #include "rsg/wire/state_values.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

@@ -6,8 +6,8 @@
 #include <string_view>
 #include <vector>
 
-#include "fuzz_check.hpp"
-#include "mcap_reader.hpp"
+#include "mcap/mcap_reader.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
 
 namespace {
 

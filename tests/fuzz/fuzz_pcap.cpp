@@ -12,10 +12,10 @@
 #include <span>
 #include <stdexcept>
 
-#include "fuzz_check.hpp"
-#include "pcap_file.hpp"
+#include "capture/pcap_file.hpp"
+#include "capture/udp_packet.hpp"
 #include "rsg/error.hpp"
-#include "udp_packet.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
 
 namespace {
 

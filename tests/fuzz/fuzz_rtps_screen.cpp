@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "dds/internal/rtps_screen.hpp"
-#include "fuzz_check.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
 
 namespace {
 

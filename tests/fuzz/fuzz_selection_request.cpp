@@ -9,8 +9,8 @@
 #include <cstring>
 #include <span>
 
-#include "fuzz_check.hpp"
 #include "rsg/wire/frame.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
 
 namespace {
 

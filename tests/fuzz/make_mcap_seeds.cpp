@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "mcap_writer.hpp"
+#include "mcap/mcap_writer.hpp"
 
 namespace {
 

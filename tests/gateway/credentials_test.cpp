@@ -1,6 +1,6 @@
 // ${CREDENTIALS_DIRECTORY} in a participant profile's properties (src/gateway/credentials.hpp):
 // the key systemd's LoadCredential= hands a DynamicUser service.
-#include "credentials.hpp"
+#include "gateway/credentials.hpp"
 
 #include <gtest/gtest.h>
 

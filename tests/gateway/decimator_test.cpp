@@ -1,4 +1,4 @@
-#include "decimator.hpp"
+#include "gateway/decimator.hpp"
 
 #include <gtest/gtest.h>
 

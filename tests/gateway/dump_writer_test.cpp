@@ -1,6 +1,6 @@
 // The flight recorder's bounds on the disk (DumpWriter): the minimum interval between dumps, and
 // rsg's own files in the folder kept within a count and a byte cap, oldest deleted first.
-#include "dump_writer.hpp"
+#include "gateway/dump_writer.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

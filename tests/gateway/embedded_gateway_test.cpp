@@ -17,10 +17,10 @@
 #include <thread>
 
 #include "dds/internal/fastdds_compat.hpp"
-#include "random_state.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
-#include "test_domain.hpp"
+#include "tests/support/random_state.hpp"
+#include "tests/support/test_domain.hpp"
 
 namespace rsg {
 namespace fdds = eprosima::fastdds::dds;

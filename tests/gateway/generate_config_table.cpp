@@ -14,7 +14,7 @@
 #include <variant>
 #include <vector>
 
-#include "config.hpp"
+#include "gateway/config.hpp"
 
 namespace {
 

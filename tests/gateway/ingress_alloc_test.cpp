@@ -27,15 +27,15 @@
 #include <span>
 #include <thread>
 
-#include "allocation_counter.hpp"
+#include "capture/pcap_file.hpp"
 #include "dds/internal/fastdds_compat.hpp"
-#include "ingress.hpp"
-#include "pcap_file.hpp"
-#include "random_state.hpp"
+#include "gateway/ingress.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/ros2.hpp"
 #include "rsg/wire/frame.hpp"
-#include "test_domain.hpp"
+#include "tests/support/allocation_counter.hpp"
+#include "tests/support/random_state.hpp"
+#include "tests/support/test_domain.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;

@@ -1,9 +1,9 @@
-#include "link_monitor.hpp"
+#include "gateway/link_monitor.hpp"
 
 #include <gtest/gtest.h>
 
-#include "log_throttle.hpp"
-#include "selection_requester.hpp"
+#include "gateway/log_throttle.hpp"
+#include "gateway/selection_requester.hpp"
 
 namespace rsg::gateway {
 namespace {

@@ -1,6 +1,6 @@
 // The metrics endpoint over a real loopback TCP connection: what each path answers, and what a
 // client that misbehaves gets. The gateway under such clients at 1 kHz: integration.metrics_abuse.
-#include "metrics_server.hpp"
+#include "gateway/metrics_server.hpp"
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // The Prometheus text exposition of the gateway's counters (src/gateway/metrics.hpp). That
 // Prometheus itself accepts it is shown by integration.metrics_prometheus (promtool and a real
 // server); here: what each line says.
-#include "metrics.hpp"
+#include "gateway/metrics.hpp"
 
 #include <gtest/gtest.h>
 

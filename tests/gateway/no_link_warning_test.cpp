@@ -1,4 +1,4 @@
-#include "no_link_warning.hpp"
+#include "gateway/no_link_warning.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Real-time mode: with privileges the thread really runs SCHED_FIFO on its CPU; without them (or
 // with an impossible CPU) it carries on with one warning. Checked on enter_realtime() directly and
 // on the rsg_gateway process.
-#include "realtime.hpp"
+#include "gateway/realtime.hpp"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -24,7 +24,7 @@
 #include <thread>
 #include <vector>
 
-#include "test_domain.hpp"
+#include "tests/support/test_domain.hpp"
 
 namespace rsg::gateway {
 namespace {

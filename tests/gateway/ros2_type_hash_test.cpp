@@ -1,4 +1,4 @@
-#include "ros2_type_hash.hpp"
+#include "gateway/ros2_type_hash.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
 // What the gateway says about its selection requests (the timing is in link_monitor_test.cpp).
-#include "selection_requester.hpp"
+#include "gateway/selection_requester.hpp"
 
 #include <gtest/gtest.h>
 
-#include "captured_log.hpp"
+#include "tests/support/captured_log.hpp"
 
 namespace rsg::gateway {
 namespace {

@@ -1,4 +1,4 @@
-#include "sequence_tracker.hpp"
+#include "gateway/status/sequence_tracker.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // ServiceNotifier against a real notification socket: a Unix datagram socket of the test's own,
 // named by NOTIFY_SOCKET as systemd would, which libsystemd's sd_notify sends to.
-#include "service_notifier.hpp"
+#include "gateway/service_notifier.hpp"
 
 #include <gtest/gtest.h>
 #include <poll.h>

@@ -1,4 +1,4 @@
-#include "source_filter.hpp"
+#include "gateway/source_filter.hpp"
 
 #include <gtest/gtest.h>
 

@@ -6,9 +6,9 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 
-#include "ros2_standard_topics.hpp"
+#include "gateway/ros2_standard_topics.hpp"
 #include "rsg/dds/participant.hpp"
-#include "test_domain.hpp"
+#include "tests/support/test_domain.hpp"
 
 namespace rsg::gateway {
 namespace {

@@ -1,6 +1,6 @@
 // The stats file (src/gateway/stats_file.hpp): what a reader of the file sees after the gateway's
 // writes, on the calling thread and through the writer thread.
-#include "stats_file.hpp"
+#include "gateway/stats_file.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "status_sample.hpp"
+#include "gateway/status/status_sample.hpp"
 
 #include <gtest/gtest.h>
 

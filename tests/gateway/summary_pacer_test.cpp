@@ -2,7 +2,7 @@
 // counters move, once an hour while nothing changes.
 #include <gtest/gtest.h>
 
-#include "log_throttle.hpp"
+#include "gateway/log_throttle.hpp"
 
 namespace rsg::gateway {
 namespace {

@@ -9,10 +9,10 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <iostream>
 
+#include "gateway/status/status_sample.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
-#include "status_sample.hpp"
 
 int main(int argc, char** argv) {
   int domain = 0;

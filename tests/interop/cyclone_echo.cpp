@@ -6,8 +6,8 @@
 #include <iostream>
 #include <string>
 
-#include "cyclone_robot_state.hpp"
 #include "rsg/wire/json.hpp"
+#include "tests/interop/cyclone_robot_state.hpp"
 
 int main(int argc, char** argv) {
   if (argc != 6) {

@@ -7,8 +7,8 @@
 #include <string>
 #include <thread>
 
-#include "cyclone_robot_state.hpp"
 #include "rsg/wire/json.hpp"
+#include "tests/interop/cyclone_robot_state.hpp"
 
 int main(int argc, char** argv) {
   if (argc != 6) {

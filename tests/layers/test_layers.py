@@ -6,8 +6,10 @@ a lower layer to a higher one, and gateway and tools, the two top layers, use ne
 
 Each folder of src/ (and its include/rsg/<layer>/ headers) is a unit of the rank below; a unit may
 use a unit of a lower rank, never one of its own rank or above (transport and the DDS-free leaves
-stand side by side). The include graph is read from every #include "..." of src/ and include/rsg/;
-the link graph from every target_link_libraries() of src/*/CMakeLists.txt, a target belonging to
+stand side by side). The include graph is read from every #include "..." of src/ and include/rsg/,
+each resolved by the one include root (a path from src/, or rsg/... from include/): a bare name, or
+a name that is no header of the tree, fails. The link graph is read from every
+target_link_libraries() of src/*/CMakeLists.txt, a target belonging to
 the folder that defines it. A folder or target the table does not know fails the test too, so a new
 one must be placed here (and in CONTRIBUTING.md's table).
 
@@ -34,14 +36,17 @@ RANKS = {
     "tools": 4,
 }
 
-# Generated headers (at build time, in the build tree) and the unit that generates them.
-GENERATED = {
+# Headers the build generates. fastddsgen's type support is included by its bare name, as the
+# generated code includes itself (and as a consumer of the installed rsg/idl/ does); rsg's own
+# generated headers are included by their path from src/, as if they were there (the build writes
+# them into the build tree's mirror of src/, next to their template when they have one).
+FASTDDSGEN = {
     "RobotState.h": "dds", "RobotStatePubSubTypes.h": "dds", "RobotStateTypeObject.h": "dds",
     "GatewayStatus.h": "dds", "GatewayStatusPubSubTypes.h": "dds", "GatewayStatusTypeObject.h": "dds",
     "StandardMessages.h": "gateway", "StandardMessagesPubSubTypes.h": "gateway",
-    "ros2_type_hashes.hpp": "gateway",
-    "recording_schemas.hpp": "app",
-    "web_assets.hpp": "tools",
+}
+GENERATED = {
+    "gateway/ros2_type_hashes.hpp",  # cmake/rsg_ros2_type_hashes.cmake, from ros2/type_hashes.py
 }
 
 SOURCE_SUFFIXES = {".hpp", ".cpp", ".h", ".in"}
@@ -59,30 +64,44 @@ def unit_of(path, root):
     return None
 
 
+def resolve(name, root):
+    """The file of src/ or include/ an #include "name" names, by the one rule (CONTRIBUTING.md,
+    "One include root"), and its unit; or (None, why) when it names none. No search by file name:
+    an include that only the including file's own folder would find fails."""
+    if name.startswith("rsg/"):
+        target = root / "include" / name
+        if target.is_file():
+            return unit_of(target, root), None
+        return None, "no such header in include/"
+    if name in FASTDDSGEN:
+        return FASTDDSGEN[name], None
+    if "/" not in name:
+        return None, "a bare name: write the header's path from src/"
+    target = root / "src" / name
+    if target.is_file() or target.with_name(target.name + ".in").is_file() or name in GENERATED:
+        return unit_of(target, root), None
+    return None, "no such header in src/ (nor one the build generates)"
+
+
 def include_edges(root):
-    """(from file, included name, from unit, to unit) for every #include "..." that names a project file."""
+    """(from file, included name, from unit, to unit) for every #include "..." of src/ and
+    include/rsg/, and the list of those that name no header by the rule."""
     files = [p for folder in ("src", "include/rsg") for p in (root / folder).rglob("*")
              if p.is_file() and p.suffix in SOURCE_SUFFIXES]
-    by_name = {}
-    for path in files:
-        by_name.setdefault(path.name, []).append(path)
     edges = []
+    unresolved = []
     for path in files:
         source_unit = unit_of(path, root)
+        installed = path.relative_to(root).parts[0] == "include"
         for name in re.findall(r'^\s*#\s*include\s+"([^"]+)"', path.read_text(errors="replace"), re.M):
-            if name.startswith("rsg/"):
-                target = root / "include" / name
-                target_unit = unit_of(target, root) if target.exists() else None
-            elif Path(name).name in GENERATED:
-                target_unit = GENERATED[Path(name).name]
-            else:
-                candidates = [path.parent / name] if (path.parent / name).exists() else \
-                    by_name.get(Path(name).name, []) + by_name.get(Path(name).name + ".in", [])
-                units = {unit_of(c, root) for c in candidates}
-                target_unit = units.pop() if len(units) == 1 else None
-            if target_unit is not None:
+            target_unit, why = resolve(name, root)
+            if why is None and installed and not name.startswith("rsg/") and name not in FASTDDSGEN:
+                why = "an installed header includes one that is not installed"
+            if why is not None:
+                unresolved.append(f"{path.relative_to(root)}: #include \"{name}\": {why}")
+            elif target_unit is not None:
                 edges.append((path.relative_to(root), name, source_unit, target_unit))
-    return edges
+    return edges, unresolved
 
 
 def link_edges(root):
@@ -113,7 +132,8 @@ def main():
     def upward(source, target):
         return source != target and (source not in RANKS or target not in RANKS or RANKS[target] >= RANKS[source])
 
-    includes = include_edges(root)
+    includes, unresolved = include_edges(root)
+    failures += unresolved
     for path, name, source, target in includes:
         if upward(source, target):
             failures.append(f"{path}: #include \"{name}\": {source} uses {target}")

@@ -14,9 +14,9 @@
 #include <fstream>
 #include <numeric>
 
-#include "mcap_reader.hpp"
-#include "mcap_recover.hpp"
-#include "mcap_writer.hpp"
+#include "mcap/mcap_reader.hpp"
+#include "mcap/mcap_recover.hpp"
+#include "mcap/mcap_writer.hpp"
 
 namespace rsg::mcap {
 namespace {

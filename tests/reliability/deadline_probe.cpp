@@ -24,11 +24,11 @@
 #include <string>
 #include <vector>
 
+#include "gateway/status/status_sample.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
-#include "status_sample.hpp"
 
 namespace {
 

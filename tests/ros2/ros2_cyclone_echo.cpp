@@ -20,10 +20,10 @@
 #include <string>
 #include <thread>
 
-#include "cyclone_robot_state.hpp"
-#include "ros2_layout.hpp"  // generated: rsg::ros2_test::ros2_layout()
-#include "ros2_reader.hpp"
 #include "rsg/wire/json.hpp"
+#include "tests/interop/cyclone_robot_state.hpp"
+#include "tests/ros2/ros2_layout.hpp"  // generated: rsg::ros2_test::ros2_layout()
+#include "tests/ros2/ros2_reader.hpp"
 
 namespace {
 

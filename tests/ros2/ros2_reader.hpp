@@ -6,7 +6,7 @@
 #include <iostream>
 #include <string>
 
-#include "cyclone_robot_state.hpp"  // Entity, Qos
+#include "tests/interop/cyclone_robot_state.hpp"  // Entity, Qos
 
 namespace rsg::ros2_test {
 

@@ -14,7 +14,7 @@
 #include <iostream>
 #include <string>
 
-#include "ros2_reader.hpp"
+#include "tests/ros2/ros2_reader.hpp"
 
 namespace {
 

@@ -51,7 +51,7 @@ def body(h):
     documented = dict(re.findall(r"^\| `([\w/]+)` \| `(RIHS01_[0-9a-f]{64})` \|$",
                                  (REPO / "docs/ros2.md").read_text(), re.MULTILINE))
     check(documented == ours, f"docs/ros2.md's table of type hashes {documented} is not the build's {ours}: "
-          "copy the build's (generated/rsg_ros2_type_hashes.hpp) into it")
+          "copy the build's (src/gateway/ros2_type_hashes.hpp) into it")
 
 
 if __name__ == "__main__":

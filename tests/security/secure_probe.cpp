@@ -48,12 +48,12 @@
 #include <vector>
 
 #include "dds/internal/fastdds_compat.hpp"
-#include "random_state.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/wire/hex.hpp"
 #include "rsg/wire/json.hpp"
+#include "tests/support/random_state.hpp"
 
 namespace rsg::security_probe {
 namespace fdds = eprosima::fastdds::dds;

@@ -3,8 +3,8 @@
 
 #include <gtest/gtest.h>
 
-#include "random_state.hpp"
 #include "rsg/wire/frame.hpp"
+#include "tests/support/random_state.hpp"
 
 namespace rsg {
 namespace {

@@ -15,12 +15,12 @@
 #include <set>
 #include <vector>
 
-#include "crc32_copy.hpp"
-#include "random_state.hpp"
 #include "rsg/wire/crc32.hpp"
 #include "rsg/wire/detail/copy_plan.hpp"
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/state_values.hpp"
+#include "tests/support/random_state.hpp"
+#include "wire/crc32_copy.hpp"
 
 namespace rsg {
 namespace {

@@ -1,9 +1,9 @@
 // Round trips over random selections and values: encode -> decode and JSON -> values are exact.
 #include <gtest/gtest.h>
 
-#include "random_state.hpp"
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/json.hpp"
+#include "tests/support/random_state.hpp"
 
 namespace rsg {
 namespace {

@@ -1,5 +1,5 @@
 // Every conformance vector: decode by value, encode byte-exact, invalid category exact.
-#include "vectors.hpp"
+#include "tests/support/vectors.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "stats.hpp"
+#include "gateway/status/stats.hpp"
 
 #include <fmt/format.h>
 

@@ -9,8 +9,8 @@
 #include <cstdint>
 #include <string>
 
+#include "gateway/status/sequence_tracker.hpp"
 #include "rsg/wire/error.hpp"
-#include "sequence_tracker.hpp"
 
 namespace rsg::gateway {
 

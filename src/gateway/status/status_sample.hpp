@@ -3,7 +3,7 @@
 
 #include <GatewayStatus.h>
 
-#include "stats.hpp"
+#include "gateway/status/stats.hpp"
 
 namespace rsg::gateway {
 

@@ -1,4 +1,4 @@
-#include "live_table.hpp"
+#include "tools/echo/live_table.hpp"
 
 #include <algorithm>
 #include <cstdarg>

@@ -21,10 +21,11 @@
 #include <stop_token>
 #include <thread>
 
-#include "dds_options.hpp"
-#include "discovery_cli.hpp"
-#include "live_table.hpp"
-#include "matched_writers.hpp"
+#include "app/dds_options.hpp"
+#include "app/discovery_cli.hpp"
+#include "app/matched_writers.hpp"
+#include "app/stop_on_signal.hpp"
+#include "app/tool_main.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
@@ -35,8 +36,7 @@
 #include "rsg/error.hpp"
 #include "rsg/wire/json.hpp"
 #include "rsg/wire/selection.hpp"
-#include "stop_on_signal.hpp"
-#include "tool_main.hpp"
+#include "tools/echo/live_table.hpp"
 
 namespace {
 

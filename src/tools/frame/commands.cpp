@@ -1,4 +1,4 @@
-#include "commands.hpp"
+#include "tools/frame/commands.hpp"
 
 #include <array>
 #include <cstdio>

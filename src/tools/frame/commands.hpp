@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <iosfwd>
 
-#include "exit_status.hpp"
+#include "app/exit_status.hpp"
 #include "rsg/wire/selection.hpp"
 
 namespace rsg::tools::frame {

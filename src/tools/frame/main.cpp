@@ -7,9 +7,9 @@
 #include <iostream>
 #include <string>
 
-#include "commands.hpp"
+#include "app/tool_main.hpp"
 #include "rsg/error.hpp"
-#include "tool_main.hpp"
+#include "tools/frame/commands.hpp"
 
 namespace {
 

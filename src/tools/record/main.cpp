@@ -14,21 +14,21 @@
 #include <limits>
 #include <optional>
 
+#include "app/discovery_cli.hpp"
+#include "app/file_options.hpp"
+#include "app/matched_writers.hpp"
+#include "app/monitor_options.hpp"
+#include "app/monitor_readers.hpp"
+#include "app/recording.hpp"
+#include "app/recording_order.hpp"
+#include "app/stop_on_signal.hpp"
+#include "app/tool_main.hpp"
 #include "dds/internal/fastdds_compat.hpp"
-#include "discovery_cli.hpp"
-#include "file_options.hpp"
-#include "matched_writers.hpp"
-#include "mcap_recover.hpp"
-#include "mcap_writer.hpp"
-#include "monitor_options.hpp"
-#include "monitor_readers.hpp"
-#include "recording.hpp"
-#include "recording_order.hpp"
+#include "mcap/mcap_recover.hpp"
+#include "mcap/mcap_writer.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
-#include "stop_on_signal.hpp"
-#include "tool_main.hpp"
 
 namespace {
 

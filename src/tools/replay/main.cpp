@@ -18,11 +18,13 @@
 #include <thread>
 #include <unordered_set>
 
+#include "app/dds_options.hpp"
+#include "app/discovery_cli.hpp"
+#include "app/recording.hpp"
+#include "app/stop_on_signal.hpp"
+#include "app/tool_main.hpp"
 #include "dds/internal/fastdds_compat.hpp"
-#include "dds_options.hpp"
-#include "discovery_cli.hpp"
-#include "mcap_reader.hpp"
-#include "recording.hpp"
+#include "mcap/mcap_reader.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
@@ -30,8 +32,6 @@
 #include "rsg/error.hpp"
 #include "rsg/transport/host_port.hpp"
 #include "rsg/transport/udp_socket.hpp"
-#include "stop_on_signal.hpp"
-#include "tool_main.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "fault_injector.hpp"
+#include "tools/sim/fault_injector.hpp"
 
 #include <cassert>
 #include <cstring>

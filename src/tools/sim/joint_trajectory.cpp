@@ -1,4 +1,4 @@
-#include "joint_trajectory.hpp"
+#include "tools/sim/joint_trajectory.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,7 @@
 #include <array>
 #include <cstdint>
 
-#include "panda.hpp"
+#include "tools/sim/panda.hpp"
 
 namespace rsg::tools::sim {
 

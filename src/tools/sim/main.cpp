@@ -8,15 +8,15 @@
 #include <string>
 #include <vector>
 
-#include "file_options.hpp"
-#include "pcap_file.hpp"
-#include "replay.hpp"
+#include "app/file_options.hpp"
+#include "app/stop_on_signal.hpp"
+#include "app/tool_main.hpp"
+#include "capture/pcap_file.hpp"
 #include "rsg/error.hpp"
 #include "rsg/transport/host_port.hpp"
-#include "simulator.hpp"
-#include "stop_on_signal.hpp"
-#include "tool_main.hpp"
-#include "udp_stream.hpp"
+#include "tools/sim/replay.hpp"
+#include "tools/sim/simulator.hpp"
+#include "tools/sim/udp_stream.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "panda.hpp"
+#include "tools/sim/panda.hpp"
 
 #include <cmath>
 

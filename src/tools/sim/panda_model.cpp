@@ -1,10 +1,10 @@
-#include "panda_model.hpp"
+#include "tools/sim/panda_model.hpp"
 
 #include <array>
 #include <cstring>
 #include <initializer_list>
 
-#include "panda.hpp"
+#include "tools/sim/panda.hpp"
 
 namespace rsg::tools::sim {
 namespace {

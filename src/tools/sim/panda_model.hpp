@@ -4,8 +4,8 @@
 #include <chrono>
 #include <cstdint>
 
-#include "joint_trajectory.hpp"
 #include "rsg/wire/state_values.hpp"
+#include "tools/sim/joint_trajectory.hpp"
 
 namespace rsg::tools::sim {
 

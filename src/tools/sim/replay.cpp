@@ -1,14 +1,14 @@
-#include "replay.hpp"
+#include "tools/sim/replay.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <cmath>
 #include <stdexcept>
 
-#include "pcap_file.hpp"
+#include "capture/pcap_file.hpp"
 #include "rsg/error.hpp"
 #include "rsg/wire/frame.hpp"
-#include "udp_stream.hpp"
+#include "tools/sim/udp_stream.hpp"
 
 namespace rsg::tools::sim {
 namespace {

@@ -1,4 +1,4 @@
-#include "schedule.hpp"
+#include "tools/sim/schedule.hpp"
 
 #include "rsg/wire/number.hpp"
 #include "rsg/wire/text.hpp"

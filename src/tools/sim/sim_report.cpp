@@ -1,4 +1,4 @@
-#include "sim_report.hpp"
+#include "tools/sim/sim_report.hpp"
 
 #include <nlohmann/json.hpp>
 #include <numeric>

@@ -1,4 +1,4 @@
-#include "simulator.hpp"
+#include "tools/sim/simulator.hpp"
 
 #include <algorithm>
 #include <cassert>

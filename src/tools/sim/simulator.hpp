@@ -14,12 +14,12 @@
 #include <span>
 #include <string>
 
-#include "fault_injector.hpp"
-#include "panda_model.hpp"
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/state_values.hpp"
-#include "schedule.hpp"
-#include "sim_report.hpp"
+#include "tools/sim/fault_injector.hpp"
+#include "tools/sim/panda_model.hpp"
+#include "tools/sim/schedule.hpp"
+#include "tools/sim/sim_report.hpp"
 
 namespace rsg::tools::sim {
 

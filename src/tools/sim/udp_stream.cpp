@@ -1,4 +1,4 @@
-#include "udp_stream.hpp"
+#include "tools/sim/udp_stream.hpp"
 
 #include <spdlog/spdlog.h>
 #include <sys/socket.h>

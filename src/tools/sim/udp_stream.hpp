@@ -7,9 +7,9 @@
 #include <cstdint>
 #include <optional>
 
-#include "pcap_file.hpp"
+#include "capture/pcap_file.hpp"
 #include "rsg/transport/udp_socket.hpp"
-#include "simulator.hpp"
+#include "tools/sim/simulator.hpp"
 
 namespace rsg::tools::sim {
 

@@ -16,19 +16,19 @@
 #include <optional>
 #include <sstream>
 
+#include "app/matched_writers.hpp"
+#include "app/monitor_options.hpp"
+#include "app/monitor_readers.hpp"
+#include "app/recording.hpp"
+#include "app/stop_on_signal.hpp"
+#include "app/tool_main.hpp"
 #include "dds/internal/fastdds_compat.hpp"
-#include "matched_writers.hpp"
-#include "monitor_options.hpp"
-#include "monitor_readers.hpp"
-#include "recording.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
 #include "rsg/transport/udp_socket.hpp"
-#include "server.hpp"
-#include "stop_on_signal.hpp"
-#include "tool_main.hpp"
-#include "view_channels.hpp"
-#include "web_assets.hpp"
+#include "tools/view/server.hpp"
+#include "tools/view/view_channels.hpp"
+#include "tools/view/web_assets.hpp"
 
 namespace {
 

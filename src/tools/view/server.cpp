@@ -1,4 +1,4 @@
-#include "server.hpp"
+#include "tools/view/server.hpp"
 
 #include <malloc.h>
 #include <pthread.h>
@@ -21,9 +21,9 @@
 #include <thread>
 #include <variant>
 
-#include "http_reply.hpp"
+#include "app/http_reply.hpp"
+#include "app/tcp_listener.hpp"
 #include "rsg/error.hpp"
-#include "tcp_listener.hpp"
 
 namespace rsg::tools::view {
 namespace {

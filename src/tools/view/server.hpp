@@ -27,7 +27,7 @@
 #include <string_view>
 #include <vector>
 
-#include "foxglove_protocol.hpp"
+#include "foxglove/foxglove_protocol.hpp"
 
 namespace rsg::tools::view {
 

@@ -1,12 +1,12 @@
-#include "view_channels.hpp"
+#include "tools/view/view_channels.hpp"
 
 #include <nlohmann/json.hpp>
 
-#include "recording_schemas.hpp"
+#include "app/recording_schemas.hpp"
+#include "gateway/status/status_sample.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/wire/eigen.hpp"
 #include "rsg/wire/error_flags.hpp"
-#include "status_sample.hpp"
 
 namespace rsg::tools::view {
 namespace {

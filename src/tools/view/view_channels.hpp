@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "foxglove_protocol.hpp"
+#include "foxglove/foxglove_protocol.hpp"
 
 namespace rsg::tools::view {
 

@@ -11,12 +11,12 @@
 #include <string>
 #include <string_view>
 
+#include "app/tool_main.hpp"
 #include "rsg/wire/error.hpp"
 #include "rsg/wire/error_flags.hpp"
 #include "rsg/wire/field_docs.hpp"
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/frame.hpp"
-#include "tool_main.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "child_process.hpp"
+#include "tests/bench/e2e/child_process.hpp"
 
 #include <fcntl.h>
 #include <signal.h>

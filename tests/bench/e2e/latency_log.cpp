@@ -1,4 +1,4 @@
-#include "latency_log.hpp"
+#include "tests/bench/e2e/latency_log.hpp"
 
 #include <algorithm>
 #include <cmath>

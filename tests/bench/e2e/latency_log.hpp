@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "stamped_frames.hpp"
+#include "tests/bench/e2e/stamped_frames.hpp"
 
 namespace rsg::bench {
 

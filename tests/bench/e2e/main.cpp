@@ -21,8 +21,8 @@
 
 #include "dds/internal/fastdds_compat.hpp"
 #include "rsg/dds/profiles.hpp"
-#include "scenarios.hpp"
-#include "test_domain.hpp"
+#include "tests/bench/e2e/scenarios.hpp"
+#include "tests/support/test_domain.hpp"
 
 namespace {
 

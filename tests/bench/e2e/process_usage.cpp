@@ -1,4 +1,4 @@
-#include "process_usage.hpp"
+#include "tests/bench/e2e/process_usage.hpp"
 
 #include <unistd.h>
 

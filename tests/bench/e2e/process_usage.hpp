@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "stamped_frames.hpp"
+#include "tests/bench/e2e/stamped_frames.hpp"
 
 namespace rsg::bench {
 

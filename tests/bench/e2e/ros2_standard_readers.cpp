@@ -1,4 +1,4 @@
-#include "ros2_standard_readers.hpp"
+#include "tests/bench/e2e/ros2_standard_readers.hpp"
 
 #include <StandardMessages.h>
 #include <StandardMessagesPubSubTypes.h>

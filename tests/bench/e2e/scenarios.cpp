@@ -1,4 +1,4 @@
-#include "scenarios.hpp"
+#include "tests/bench/e2e/scenarios.hpp"
 
 #include <time.h>
 #include <unistd.h>
@@ -17,16 +17,16 @@
 #include <stop_token>
 #include <thread>
 
-#include "../floor/relay_loop.hpp"
-#include "child_process.hpp"
-#include "latency_log.hpp"
-#include "process_usage.hpp"
-#include "ros2_standard_readers.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/gateway/embedded_gateway.hpp"
 #include "rsg/transport/udp_socket.hpp"
-#include "stamped_frames.hpp"
-#include "state_subscriber.hpp"
+#include "tests/bench/e2e/child_process.hpp"
+#include "tests/bench/e2e/latency_log.hpp"
+#include "tests/bench/e2e/process_usage.hpp"
+#include "tests/bench/e2e/ros2_standard_readers.hpp"
+#include "tests/bench/e2e/stamped_frames.hpp"
+#include "tests/bench/e2e/state_subscriber.hpp"
+#include "tests/bench/floor/relay_loop.hpp"
 
 namespace rsg::bench {
 namespace fdds = eprosima::fastdds::dds;

@@ -1,4 +1,4 @@
-#include "stamped_frames.hpp"
+#include "tests/bench/e2e/stamped_frames.hpp"
 
 #include <bit>
 #include <cstring>

@@ -1,4 +1,4 @@
-#include "state_subscriber.hpp"
+#include "tests/bench/e2e/state_subscriber.hpp"
 
 #include <fastdds/dds/core/LoanableSequence.hpp>
 #include <fastdds/dds/core/condition/WaitSet.hpp>

@@ -15,8 +15,8 @@
 #include <string>
 #include <thread>
 
-#include "latency_log.hpp"
 #include "rsg/dds/participant.hpp"
+#include "tests/bench/e2e/latency_log.hpp"
 
 namespace rsg::bench {
 

@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "cyclone_topic.hpp"
+#include "tests/bench/floor/cyclone_topic.hpp"
 
 namespace {
 

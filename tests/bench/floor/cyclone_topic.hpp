@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "cyclone_robot_state.hpp"
+#include "tests/interop/cyclone_robot_state.hpp"
 
 namespace rsg::bench {
 

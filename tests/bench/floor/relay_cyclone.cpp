@@ -4,8 +4,8 @@
 #include <iostream>
 #include <string>
 
-#include "cyclone_topic.hpp"
-#include "relay_loop.hpp"
+#include "tests/bench/floor/cyclone_topic.hpp"
+#include "tests/bench/floor/relay_loop.hpp"
 
 int main(int argc, char** argv) {
   if (argc != 3) {

@@ -27,7 +27,6 @@
 #include <thread>
 #include <vector>
 
-#include "../e2e/stamped_frames.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
@@ -35,6 +34,7 @@
 #include "rsg/dds/ros2.hpp"
 #include "rsg/dds/views.hpp"
 #include "rsg/transport/udp_socket.hpp"
+#include "tests/bench/e2e/stamped_frames.hpp"
 
 namespace {
 

@@ -1,13 +1,13 @@
 // Every crafted corruption is rejected by the codec's decoder with exactly the category it aims at.
-#include "fault_injector.hpp"
+#include "tools/sim/fault_injector.hpp"
 
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <string>
 
-#include "panda_model.hpp"
-#include "schedule.hpp"
+#include "tools/sim/panda_model.hpp"
+#include "tools/sim/schedule.hpp"
 
 namespace rsg::tools::sim {
 namespace {

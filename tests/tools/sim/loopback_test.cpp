@@ -5,10 +5,10 @@
 #include <atomic>
 #include <thread>
 
-#include "captured_log.hpp"
 #include "rsg/transport/udp_socket.hpp"
-#include "simulator.hpp"
-#include "udp_stream.hpp"
+#include "tests/support/captured_log.hpp"
+#include "tools/sim/simulator.hpp"
+#include "tools/sim/udp_stream.hpp"
 
 namespace rsg::tools::sim {
 namespace {

@@ -1,13 +1,13 @@
 // The robot state the simulator fills: consistent with the motion, the spec and itself.
-#include "panda_model.hpp"
+#include "tools/sim/panda_model.hpp"
 
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
 
-#include "panda.hpp"
 #include "rsg/wire/frame.hpp"
+#include "tools/sim/panda.hpp"
 
 namespace rsg::tools::sim {
 namespace {

@@ -1,9 +1,9 @@
 // Kinematics and trajectory of the simulated Panda against known poses and their own derivatives.
-#include "panda.hpp"
+#include "tools/sim/panda.hpp"
 
 #include <gtest/gtest.h>
 
-#include "joint_trajectory.hpp"
+#include "tools/sim/joint_trajectory.hpp"
 
 namespace rsg::tools::sim {
 namespace {

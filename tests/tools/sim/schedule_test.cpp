@@ -1,4 +1,4 @@
-#include "schedule.hpp"
+#include "tools/sim/schedule.hpp"
 
 #include <gtest/gtest.h>
 

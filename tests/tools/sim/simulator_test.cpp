@@ -1,5 +1,5 @@
 // The simulator's stream, checked datagram by datagram against its own report and recording.
-#include "simulator.hpp"
+#include "tools/sim/simulator.hpp"
 
 #include <gtest/gtest.h>
 
