@@ -5,13 +5,9 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <filesystem>
-#include <stdexcept>
-#include <thread>
 #include <utility>
 
 #include "gateway/credentials.hpp"

@@ -3,11 +3,9 @@
 #include <spdlog/spdlog.h>
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
-#include <stdexcept>
 
 #include "dds/internal/fastdds_compat.hpp"  // is_plain
 #include "gateway/ros2_type_hash.hpp"
-#include "rsg/error.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;
@@ -123,7 +121,7 @@ Ingress::Ingress(dds::Participant& participant, Options options)
 Ingress::~Ingress() = default;
 
 void Ingress::start(Clock::time_point now) {
-  if (requester_ && options_.robot && requester_->start_up_due(now)) request_selection(*options_.robot, now);
+  if (requester_ && options_.robot && requester_->start_up_due(now)) request_selection(*options_.robot);
 }
 
 void Ingress::receive(std::chrono::milliseconds timeout) {
@@ -196,7 +194,7 @@ void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::
   link_came_up_ |= link_.on_frame(arrival);
   source_ = datagram.from;
   if (requester_ && requester_->due(frame.selection(), now))
-    request_selection(options_.robot ? *options_.robot : datagram.from, now);
+    request_selection(options_.robot ? *options_.robot : datagram.from);
 
   if (sequence_.releases_held()) {
     deliver(held_sample_, held_selection_, held_time_ms_, now);
@@ -257,7 +255,7 @@ void Ingress::reject(const wire::FrameError& error, const transport::Endpoint& s
   last_rejected_sender_ = sender;
 }
 
-void Ingress::request_selection(const transport::Endpoint& robot, Clock::time_point) {
+void Ingress::request_selection(const transport::Endpoint& robot) {
   std::array<std::uint8_t, wire::kSelectionRequestBytes> request{};
   const wire::EncodeResult encoded =
       encode_selection_request(request_packet_number_, requester_->wanted(), request);

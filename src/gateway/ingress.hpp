@@ -124,7 +124,7 @@ class Ingress {
   void handle(const transport::DatagramBatch::Datagram& datagram, Clock::time_point now,
               Clock::time_point arrival);
   void reject(const wire::FrameError& error, const transport::Endpoint& sender);
-  void request_selection(const transport::Endpoint& robot, Clock::time_point now);
+  void request_selection(const transport::Endpoint& robot);
   void write_rate_topics(const RobotState& sample, std::chrono::nanoseconds t);
   void record_age(std::uint64_t robot_time_ms, Clock::time_point arrival, Clock::time_point published);
   // The consumer, rate topics and standard topics: every output but the full-rate write.

@@ -17,7 +17,6 @@
 
 namespace rsg::gateway {
 
-/// What one scrape reports: the gateway's counters as of the last status period or link change.
 /// The flight recorder's dumps since start, by how they ended (DumpWriter).
 struct DumpCounts {
   std::uint64_t written = 0;
@@ -42,6 +41,7 @@ struct DdsGuardCounts {
   std::uint64_t destinations_skipped = 0;
 };
 
+/// What one scrape reports: the gateway's counters as of the last status period or link change.
 struct MetricsSnapshot {
   GatewayStats stats;
   bool has_ingress = false;

@@ -34,8 +34,6 @@ class SourceFilter {
   /// True when no network was added (everyone is allowed) or `source` lies in one of them.
   bool allows(const sockaddr* source) const noexcept;
 
-  bool allows_everyone() const { return networks_.empty(); }
-
  private:
   std::vector<Network> networks_;
 };

@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "rsg/wire/crc32.hpp"
-#include "rsg/wire/deframer.hpp"
 #include "rsg/wire/error_flags.hpp"
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/frame_codec.hpp"
@@ -227,22 +226,6 @@ void BM_Encode(benchmark::State& state, const SampleFrame& frame) {
   count_bytes(state, frame.bytes().size());
 }
 
-/// A stream of back-to-back frames arriving in 1472-byte pieces (a UDP payload on a 1500-byte MTU),
-/// so frames straddle reads. One iteration delivers one frame's worth of bytes and yields one frame.
-void BM_Deframer(benchmark::State& state, const SampleFrame& frame) {
-  constexpr std::size_t kReadBytes = 1472;
-  rsg::wire::Deframer deframer;
-  benchmark::IterationCount frames = 0;
-  const auto count = [&frames](std::span<const std::uint8_t>) { ++frames; };
-  for (auto _ : state) {
-    for (std::size_t offset = 0; offset < frame.bytes().size(); offset += kReadBytes)
-      deframer.feed(frame.bytes().subspan(offset, std::min(kReadBytes, frame.bytes().size() - offset)),
-                    count);
-  }
-  if (frames != state.iterations()) state.SkipWithError("the deframer lost frames");
-  count_bytes(state, frame.bytes().size());
-}
-
 }  // namespace
 
 BENCHMARK_CAPTURE(BM_Memcpy, Full, full_frame())->Name("BM_Memcpy_Full");
@@ -256,7 +239,6 @@ BENCHMARK_CAPTURE(BM_DecodeFrameAt, LineAligned, full_frame(), 0)->Name("BM_Deco
 BENCHMARK_CAPTURE(BM_DecodeFrameAt, ChunksAligned, full_frame(), head_padding(full_frame()))
     ->Name("BM_DecodeChunksLineAligned_Full");
 BENCHMARK_CAPTURE(BM_Encode, Full, full_frame())->Name("BM_Encode_Full");
-BENCHMARK_CAPTURE(BM_Deframer, Full, full_frame())->Name("BM_Deframer_Full");
 
 BENCHMARK_CAPTURE(BM_Crc32Isal, Joints, joints_frame())->Name("BM_Crc32Isal_Joints");
 BENCHMARK_CAPTURE(BM_Decode, Joints, joints_frame())->Name("BM_Decode_Joints");

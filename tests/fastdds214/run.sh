@@ -105,9 +105,11 @@ else
   echo214=$(mixed echo214 rsg_echo rsg_status_probe)
   publish214=$(mixed publish214 rsg_views_publish)
   # Views, content filters included: 2.14 readers on a 2.9 writer's stream, and 2.9 readers on 2.14's.
-  check views_2.9_writer_2.14_readers python3 tests/dds/echo_views_test.py --echo "$echo214/rsg_echo" \
+  check views_2.9_writer_2.14_readers env RSG_SIM="$host_build/bin/rsg_sim" RSG_GATEWAY="$host_build/bin/rsg_gateway" \
+    python3 tests/dds/echo_views_test.py --echo "$echo214/rsg_echo" \
     --publish "$host_build/bin/rsg_views_publish" -v
-  check views_2.14_writer_2.9_readers python3 tests/dds/echo_views_test.py --echo "$host_build/bin/rsg_echo" \
+  check views_2.14_writer_2.9_readers env RSG_SIM="$host_build/bin/rsg_sim" RSG_GATEWAY="$host_build/bin/rsg_gateway" \
+    python3 tests/dds/echo_views_test.py --echo "$host_build/bin/rsg_echo" \
     --publish "$publish214/rsg_views_publish" -v
   # The pipeline: a 2.14 gateway read by 2.9's rsg_echo (and status probe), a 2.9 gateway read by 2.14's.
   check sim_to_echo_2.14_gateway_2.9_echo python3 tests/integration/test_sim_to_echo.py --bin "$gateway214"

@@ -78,9 +78,11 @@ else
   publish3=$(mixed publish3 rsg_views_publish)
   gateway_echo3=$(mixed gateway_echo3 rsg_gateway rsg_echo)
   # Views, content filters included: 3.x readers on a 2.9 writer's stream, and 2.9 readers on 3.x's.
-  check views_2.9_writer_3_readers python3 tests/dds/echo_views_test.py --echo "$echo3/rsg_echo" \
+  check views_2.9_writer_3_readers env RSG_SIM="$host_build/bin/rsg_sim" RSG_GATEWAY="$host_build/bin/rsg_gateway" \
+    python3 tests/dds/echo_views_test.py --echo "$echo3/rsg_echo" \
     --publish "$host_build/bin/rsg_views_publish" -v
-  check views_3_writer_2.9_readers python3 tests/dds/echo_views_test.py --echo "$host_build/bin/rsg_echo" \
+  check views_3_writer_2.9_readers env RSG_SIM="$host_build/bin/rsg_sim" RSG_GATEWAY="$host_build/bin/rsg_gateway" \
+    python3 tests/dds/echo_views_test.py --echo "$host_build/bin/rsg_echo" \
     --publish "$publish3/rsg_views_publish" -v
   # The pipeline: a 3.x gateway read by 2.9's rsg_echo, a 2.9 gateway read by 3.x's, values exact.
   check sim_to_echo_3_gateway_2.9_echo python3 tests/integration/test_sim_to_echo.py --bin "$gateway3"

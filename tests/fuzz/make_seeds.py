@@ -30,21 +30,6 @@ def decode_seeds(valid, invalid):
     return [bytes.fromhex(v["frame_hex"]) for v in valid + invalid]
 
 
-def deframer_seeds(valid, invalid, rng):
-    """[n][n chunk sizes][stream]: streams of frames, garbage and cut frames under various chunkings."""
-    frames = decode_seeds(valid, invalid)
-    seeds = [bytes([0]) + b"".join(frames[:20])]
-    for _ in range(40):
-        stream = b""
-        for _ in range(rng.randint(1, 4)):
-            stream += rng.randbytes(rng.choice([0, 0, 1, 3, 17]))  # resynchronisation material
-            stream += rng.choice(frames)
-        stream += rng.choice(frames)[: rng.randint(0, 40)]  # a frame still arriving
-        plan = bytes(rng.randrange(256) for _ in range(rng.choice([0, 1, 3, 8])))
-        seeds.append(bytes([len(plan)]) + plan + stream)
-    return seeds
-
-
 def json_seeds(valid):
     return [json.dumps(v["decoded"], separators=(",", ":")).encode() for v in valid]
 
@@ -107,7 +92,6 @@ def main():
     rng = random.Random(2137)  # fixed: the same vectors always give the same seeds
     corpora = {
         "fuzz_decode": decode_seeds(valid, invalid),
-        "fuzz_deframer": deframer_seeds(valid, invalid, rng),
         "fuzz_json": json_seeds(valid),
         "fuzz_selection_request": selection_request_seeds(rng),
         "fuzz_pcap": pcap_seeds(valid),
