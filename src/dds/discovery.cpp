@@ -49,8 +49,9 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
   }
   if (!options.servers.empty()) {
     builtin.discovery_config.discoveryProtocol = rsg::dds::DiscoveryProtocol::CLIENT;
-    // Fast DDS's 450 ms cycle made a gateway's first sample reach a reader ~1.1 s after start; at
-    // 50 ms (with xml_profiles/discovery_server/ on the server) it is ~0.4 s, same traffic once matched.
+    // Fast DDS's default period delays a gateway's first sample at a reader; 50 ms (with
+    // xml_profiles/discovery_server/ on the server) shortens that, with the same traffic once
+    // matched (docs/deploying.md).
     builtin.discovery_config.discoveryServer_client_syncperiod = rsg::dds::Duration(0, 50'000'000);
   }
 

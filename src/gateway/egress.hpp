@@ -123,7 +123,7 @@ class Egress {
   LogThrottle request_like_log_{std::chrono::seconds(10)};
   LogThrottle rate_limited_log_{std::chrono::seconds(10)};
 
-  std::thread thread_;  // last: starts once everything it uses exists
+  std::jthread thread_;  // last: starts once everything it uses exists; named rsg-egress
 };
 
 }  // namespace rsg::gateway

@@ -1,5 +1,6 @@
 #include "rsg/gateway/embedded_gateway.hpp"
 
+#include <pthread.h>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
@@ -42,7 +43,9 @@ class EmbeddedGateway::Impl {
  public:
   Impl(std::string_view yaml_config, SampleCallback on_sample)
       : setup_(prepare_embedded(yaml_config, std::move(on_sample))), gateway_(setup_) {
-    thread_ = std::thread([this] {
+    thread_ = std::jthread([this] {
+      // The ingress loop: rsg_gateway runs it on its main thread, the embedded gateway on this one.
+      ::pthread_setname_np(::pthread_self(), "rsg-ingress");  // top -H, perf, tests find it by name
       gateway::enter_realtime_mode(setup_.config);
       try {
         gateway_.run(stop_);
@@ -65,7 +68,7 @@ class EmbeddedGateway::Impl {
   gateway::GatewaySetup setup_;
   gateway::Gateway gateway_;
   std::atomic<bool> stop_{false};
-  std::thread thread_;  // last: started once everything it uses exists
+  std::jthread thread_;  // last: started once everything it uses exists
 };
 
 EmbeddedGateway::EmbeddedGateway(std::string_view yaml_config, SampleCallback on_sample)

@@ -33,8 +33,9 @@ class SampleSlot {
       : writer_(writer), fallback_(&fallback), sample_(&fallback) {
     // No initialisation of the loan: a successful decode writes every member (header,
     // group_present and each field, absent ones zeroed; robot_state_mapping_test checks it on
-    // poisoned memory), so constructing the sample first would only cost ~5 % of the gateway's
-    // CPU at 1 kHz. Without a loan (type not plain, every loanable slot in use): the fallback.
+    // poisoned memory), so constructing the sample first would only cost CPU on every frame
+    // (docs/benchmarks/e2e.md). Without a loan (type not plain, every loanable slot in use): the
+    // fallback.
     if (loans &&
         writer_.loan_sample(loan_, fdds::DataWriter::LoanInitializationKind::NO_LOAN_INITIALIZATION) ==
             rsg::dds::kOk)

@@ -212,7 +212,7 @@ struct MetricsServer::Impl {
   app::AcceptLoop accepting{acceptor, "metrics",
                             [this](tcp::socket socket) { on_connection(std::move(socket)); },
                             [this] { shared.table.evict_oldest_waiting(); }};
-  std::thread thread;
+  std::jthread thread;  // named rsg-metrics
 
   void on_connection(tcp::socket socket) {
     beast::error_code ec;
@@ -237,7 +237,7 @@ MetricsServer::MetricsServer(const Options& options, MetricsSnapshot first)
   if (const auto ec = rsg::app::listen_on(impl_->acceptor, to_asio(options.listen)))
     throw EnvironmentError("--metrics: cannot listen on " + options.listen.to_string() + ": " + ec.message());
   impl_->accepting.start();
-  impl_->thread = std::thread([impl = impl_.get()] {
+  impl_->thread = std::jthread([impl = impl_.get()] {
     ::pthread_setname_np(::pthread_self(), "rsg-metrics");
     impl->io.run();
   });

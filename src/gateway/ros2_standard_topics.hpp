@@ -114,7 +114,7 @@ class Ros2StandardTopics {
   std::atomic<std::uint32_t> wake_{0};  // bumped on every push and on stop; run() waits on it
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> dropped_{0};
-  std::thread thread_;
+  std::jthread thread_;  // last: starts once everything it uses exists; named rsg-ros2-topics
 };
 
 }  // namespace rsg::gateway

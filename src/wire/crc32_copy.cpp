@@ -54,7 +54,7 @@ static_assert(fold_by(512).low == 0x1'5444'2BD4 && fold_by(512).high == 0x1'C6E4
 static_assert(fold_by(128).low == 0x1'7519'97D0 && fold_by(128).high == 0xCCAA'009E);
 
 // Independent remainders, to cover the multiply latency. Four already keep an Intel Xeon's
-// multiplier busy (a fold: 5 cycles latency, 2 cycles of VPCLMULQDQ throughput); eight measured no
+// multiplier busy (a fold's latency is a few times VPCLMULQDQ's issue interval); eight were no
 // faster there (docs/benchmarks/wire.md).
 constexpr std::size_t kChunksPerRound = 4;
 constexpr std::size_t kRoundBytes = kChunksPerRound * kChunkBytes;
@@ -79,9 +79,9 @@ RSG_STITCHED_INLINE __mmask64 range_mask(unsigned first, unsigned end) {
 }
 
 // Masked accesses that straddle a page boundary, with masked-off bytes on the far side, are slow:
-// ~400 cycles per store on AMD Zen 4 (measured here: 164 ns against 0.5 ns). A masked load did the
-// same in one measured placement, reaching masked-off into the page before a static array (not
-// with both pages in use). A frame or struct placed at such an offset would pay that on every
+// far slower than a plain one on AMD Zen 4 (docs/benchmarks/wire.md). A masked load did the
+// same in one placement, reaching masked-off into the page before a static array (not with both
+// pages in use). A frame or struct placed at such an offset would pay that on every
 // frame. So a partial chunk whose 64 bytes would straddle a page goes through 64-byte-aligned
 // windows, which never do, with the bytes rotated into place.
 
@@ -192,8 +192,8 @@ class ChunkCopy {
   /// Folds the rounds from `at` on that lie inside one run of whole chunks and end by `limit`,
   /// copying them as they go; returns where it stopped (`at` if the round at `at` is not inside a
   /// run). The loop carries two pointers and nothing else: with the run's bookkeeping inside it,
-  /// the compiler spilled counters to the stack and the round took longer than its multiplies
-  /// (measured on an Intel Xeon, docs/benchmarks/wire.md).
+  /// the compiler spilled counters to the stack and the round was slower than its multiplies
+  /// (on an Intel Xeon, docs/benchmarks/wire.md).
   RSG_STITCHED_INLINE std::size_t fold_run(std::size_t at, std::size_t limit, __m512i k, __m512i& r0,
                                            __m512i& r1, __m512i& r2, __m512i& r3) {
     if (!runs_.cover(at, kRoundBytes)) return at;

@@ -56,8 +56,8 @@ inline std::uint64_t read_error_set(const void* p) {
 
 // The six data_select bytes as one integer, byte g at bits 8g..8g+7, by a 4-byte and a 2-byte load:
 // GCC compiles a 6-byte memcpy into a zeroed uint64 to stores into a stack slot and an 8-byte
-// reload of it, which stalls on store-to-load forwarding every time (75 % of header_passes's
-// samples in perf on an Intel Xeon).
+// reload of it, which stalls on store-to-load forwarding every time (most of header_passes's
+// samples in perf on an Intel Xeon: docs/benchmarks/wire.md).
 inline std::uint64_t read_data_select(const Selection& selection) {
   static_assert(kGroupCount == 6, "a 4-byte and a 2-byte load");
   const std::uint8_t* bytes = selection.data_select.data();
@@ -190,8 +190,8 @@ inline std::uint64_t selection_key(const Selection& selection) {
 /// The same read from the frame's bytes rather than from the Selection just filled from them:
 /// reloading freshly stored bytes at another width would stall on store-to-load forwarding. One
 /// 8-byte load of bytes 2..9 (inside the header), shifted: a 7-byte memcpy into a zeroed integer
-/// compiled to two 4-byte stores and an 8-byte reload, which stalls the same way (~8 % of a
-/// decode on an Intel Xeon).
+/// compiled to two 4-byte stores and an 8-byte reload, which stalls the same way
+/// (docs/benchmarks/wire.md).
 inline std::uint64_t selection_key(std::span<const std::uint8_t> frame) {
   static_assert(kHeaderBytes >= 3 + 1 + kGroupCount, "bytes 2..9 lie in the header");
   std::uint64_t bytes;

@@ -70,6 +70,9 @@ void append_field(const FieldInfo& field, const StateValues& values, std::string
 
 using Json = nlohmann::json;
 
+/// What a step of the parser returns that reads into a StateValues it is given: done, or why not.
+struct Read {};
+
 bool read_unsigned(const Json& node, std::uint64_t max, std::uint64_t& out) {
   if (!node.is_number_unsigned() && !(node.is_number_integer() && node.get<std::int64_t>() >= 0))
     return false;
@@ -95,88 +98,72 @@ bool read_double(const Json& node, double& out) {
   return true;
 }
 
-bool read_field(const FieldInfo& field, const Json& node, StateValues& out, std::string& error) {
+/// Reads `node` into `out`'s elements of `field`.
+Parsed<Read> read_field(const FieldInfo& field, const Json& node, StateValues& out) {
   const std::string name(field.name);
   switch (field.type) {
     case ElementType::kFloat64: {
       auto elements = out.doubles(field.id());
       if (field.is_scalar()) {
-        if (read_double(node, elements[0])) return true;
-        error = name + ": expected a number or \"nan\"/\"inf\"/\"-inf\"";
-        return false;
+        if (read_double(node, elements[0])) return Read{};
+        return ParseFailure{name + ": expected a number or \"nan\"/\"inf\"/\"-inf\""};
       }
-      if (!node.is_array() || node.size() != field.count) {
-        error = name + ": expected an array of " + std::to_string(field.count) + " numbers";
-        return false;
-      }
+      if (!node.is_array() || node.size() != field.count)
+        return ParseFailure{name + ": expected an array of " + std::to_string(field.count) + " numbers"};
       for (std::size_t i = 0; i < elements.size(); ++i) {
         if (!read_double(node[i], elements[i])) {
-          error = name + "[" + std::to_string(i) + "]: expected a number or \"nan\"/\"inf\"/\"-inf\"";
-          return false;
+          return ParseFailure{name + "[" + std::to_string(i) +
+                              "]: expected a number or \"nan\"/\"inf\"/\"-inf\""};
         }
       }
-      return true;
+      return Read{};
     }
     case ElementType::kErrorSet: {
-      if (!node.is_array()) {
-        error = name + ": expected an array of error flag names";
-        return false;
-      }
+      if (!node.is_array()) return ParseFailure{name + ": expected an array of error flag names"};
       std::uint64_t bits = 0;
       for (const Json& flag : node) {
         const auto* text = flag.is_string() ? &flag.get_ref<const std::string&>() : nullptr;
         std::size_t bit = 0;
         while (text && bit < kErrorFlagCount && kErrorFlagNames[bit] != *text) ++bit;
-        if (!text || bit == kErrorFlagCount) {
-          error = name + ": " + flag.dump() + " is not an error flag name";
-          return false;
-        }
+        if (!text || bit == kErrorFlagCount)
+          return ParseFailure{name + ": " + flag.dump() + " is not an error flag name"};
         bits |= std::uint64_t{1} << bit;
       }
       out.set_integer(field.id(), bits);
-      return true;
+      return Read{};
     }
     case ElementType::kUInt8:
     case ElementType::kUInt64: {
       const std::uint64_t max =
           field.type == ElementType::kUInt8 ? 0xFF : std::numeric_limits<std::uint64_t>::max();
       std::uint64_t value = 0;
-      if (!read_unsigned(node, max, value)) {
-        error = name + ": expected an unsigned integer up to " + std::to_string(max);
-        return false;
-      }
+      if (!read_unsigned(node, max, value))
+        return ParseFailure{name + ": expected an unsigned integer up to " + std::to_string(max)};
       out.set_integer(field.id(), value);
-      return true;
+      return Read{};
     }
   }
-  return false;
+  return ParseFailure{name + ": an element type this parser does not know"};
 }
 
-bool read_header(const Json& root, StateValues& out, std::string& error) {
+/// Reads packet_number, group_select and data_select into `out`.
+Parsed<Read> read_header(const Json& root, StateValues& out) {
   std::uint64_t value = 0;
-  if (!root.contains("packet_number") || !read_unsigned(root["packet_number"], 15, value)) {
-    error = "packet_number: expected an integer 0..15";
-    return false;
-  }
+  if (!root.contains("packet_number") || !read_unsigned(root["packet_number"], 15, value))
+    return ParseFailure{"packet_number: expected an integer 0..15"};
   out.packet_number = static_cast<std::uint8_t>(value);
-  if (!root.contains("group_select") || !read_unsigned(root["group_select"], 255, value)) {
-    error = "group_select: expected an integer 0..255";
-    return false;
-  }
+  if (!root.contains("group_select") || !read_unsigned(root["group_select"], 255, value))
+    return ParseFailure{"group_select: expected an integer 0..255"};
   out.selection.group_select = static_cast<std::uint8_t>(value);
   const Json* data_select = root.contains("data_select") ? &root["data_select"] : nullptr;
-  if (!data_select || !data_select->is_array() || data_select->size() != kGroupCount) {
-    error = "data_select: expected an array of 6 integers 0..255";
-    return false;
-  }
+  if (!data_select || !data_select->is_array() || data_select->size() != kGroupCount)
+    return ParseFailure{"data_select: expected an array of 6 integers 0..255"};
   for (std::size_t group = 0; group < kGroupCount; ++group) {
-    if (!read_unsigned((*data_select)[group], 255, value)) {
-      error = "data_select[" + std::to_string(group) + "]: expected an integer 0..255";
-      return false;
-    }
+    if (!read_unsigned((*data_select)[group], 255, value))
+      return ParseFailure{"data_select[" + std::to_string(group) + "]: expected an integer 0..255"};
     out.selection.data_select[group] = static_cast<std::uint8_t>(value);
   }
-  return true;
+  return Read{};
 }
 
 }  // namespace
@@ -211,61 +198,34 @@ std::string to_canonical_json(const StateValues& values) {
   return out;
 }
 
-namespace {
-
-bool parse_into(std::string_view text, StateValues& out, std::string& error) {
+Parsed<StateValues> parse_canonical_json(std::string_view text) {
   Json root;
   try {
     root = Json::parse(text);
   } catch (const Json::exception& e) {  // parse_error, and out_of_range for numbers beyond double
-    error = std::string("malformed JSON: ") + e.what();
-    return false;
+    return ParseFailure{std::string("malformed JSON: ") + e.what()};
   }
-  if (!root.is_object()) {
-    error = "expected a JSON object";
-    return false;
-  }
+  if (!root.is_object()) return ParseFailure{"expected a JSON object"};
   for (const auto& [key, value] : root.items()) {
-    if (key != "packet_number" && key != "group_select" && key != "data_select" && key != "fields") {
-      error = "unknown key '" + key + "'";
-      return false;
-    }
+    if (key != "packet_number" && key != "group_select" && key != "data_select" && key != "fields")
+      return ParseFailure{"unknown key '" + key + "'"};
   }
   StateValues values;
-  if (!read_header(root, values, error)) return false;
-  if (!root.contains("fields") || !root["fields"].is_object()) {
-    error = "fields: expected an object";
-    return false;
-  }
+  if (const auto header = read_header(root, values); !header) return ParseFailure{header.error()};
+  if (!root.contains("fields") || !root["fields"].is_object())
+    return ParseFailure{"fields: expected an object"};
   const Json& fields = root["fields"];
   for (const auto& [key, value] : fields.items()) {
     const auto field = find_field(key);
-    if (!field) {
-      error = "fields: '" + key + "' is not a field name of docs/protocol.md";
-      return false;
-    }
-    if (!values.selection.contains(*field)) {
-      error = "fields: '" + key + "' is not selected by data_select";
-      return false;
-    }
-    if (!read_field(info(*field), value, values, error)) return false;
+    if (!field) return ParseFailure{"fields: '" + key + "' is not a field name of docs/protocol.md"};
+    if (!values.selection.contains(*field))
+      return ParseFailure{"fields: '" + key + "' is not selected by data_select"};
+    if (const auto read = read_field(info(*field), value, values); !read) return ParseFailure{read.error()};
   }
   for (const FieldInfo& field : kFields) {
-    if (values.selection.contains(field.id()) && !fields.contains(field.name)) {
-      error = "fields: '" + std::string(field.name) + "' is selected by data_select but missing";
-      return false;
-    }
+    if (values.selection.contains(field.id()) && !fields.contains(field.name))
+      return ParseFailure{"fields: '" + std::string(field.name) + "' is selected by data_select but missing"};
   }
-  out = values;
-  return true;
-}
-
-}  // namespace
-
-Parsed<StateValues> parse_canonical_json(std::string_view text) {
-  StateValues values;
-  std::string error;
-  if (!parse_into(text, values, error)) return ParseFailure{std::move(error)};
   return values;
 }
 

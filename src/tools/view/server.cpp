@@ -527,7 +527,7 @@ struct Server::Impl {
                               hub.count(LimitEvent::kAcceptFailures, "accept failed: backing off");
                               hub.table.evict_oldest_waiting();
                             }};
-  std::thread thread;
+  std::jthread thread;  // named rsg-view-http
 
   void on_connection(tcp::socket socket) {
     beast::error_code ec;
@@ -569,7 +569,7 @@ Server::Server(const ServerOptions& options, std::vector<foxglove::Channel> chan
     throw EnvironmentError("cannot listen on " + options.host + ":" + std::to_string(options.port) + ": " +
                            listen_error.message());
   impl_->accepting.start();
-  impl_->thread = std::thread([impl = impl_.get()] {
+  impl_->thread = std::jthread([impl = impl_.get()] {
     ::pthread_setname_np(::pthread_self(), "rsg-view-http");  // CONTRIBUTING.md, Threads
     impl->io.run();
   });

@@ -1,0 +1,118 @@
+#!/usr/bin/env python3
+"""The rules of CONTRIBUTING.md that a reading of the text can check, checked:
+
+- include: every #include "..." of tests/ and examples/ names its file by the one include root
+  ("rsg/..." from include/, a path from src/, "tests/..." from the checkout; examples only the
+  installed "rsg/..."), never by a bare name (src/ and include/rsg/ are layers.no_upward_edges').
+- thread: no std::thread in src/ or include/ (the rule is std::jthread).
+- thread-name: a file of src/ that holds or starts a std::jthread (or the .hpp/.cpp beside it of the
+  same name) names that thread rsg-<role> with pthread_setname_np, within Linux's 15 characters,
+  and no two threads share a name (top -H, perf and tests/integration/thread_freeze.py find them).
+- figure: no measured figure in a comment of src/ or include/: a number with a unit of time, a
+  ratio or a throughput, written as measured ("~5 %") or next to words that say so ("measured",
+  "took", "costs"). Figures go into docs/benchmarks/, and the comment points there.
+
+Each failure names the file, the line and the rule. Run by ctest as rules.code (label unit); by hand:
+tests/rules/test_rules.py [CHECKOUT]. Standard library only.
+"""
+
+import re
+import sys
+from pathlib import Path
+
+SOURCE_SUFFIXES = {".hpp", ".cpp", ".h", ".cc", ".c", ".in"}
+INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
+# fastddsgen's type support, included by its bare name (CONTRIBUTING.md, "One include root").
+FASTDDSGEN = {"RobotState.h", "RobotStatePubSubTypes.h", "RobotStateTypeObject.h", "GatewayStatus.h",
+              "GatewayStatusPubSubTypes.h", "GatewayStatusTypeObject.h", "StandardMessages.h",
+              "StandardMessagesPubSubTypes.h"}
+# Headers the build writes into its mirror of src/ or tests/ without a template beside them.
+GENERATED = {"gateway/ros2_type_hashes.hpp", "tests/ros2/ros2_layout.hpp"}
+THREAD = re.compile(r"\bstd::thread\b")
+JTHREAD = re.compile(r"\bstd::jthread\b")
+THREAD_NAME = re.compile(r'pthread_setname_np\(\s*::pthread_self\(\)\s*,\s*"([^"]*)"\s*\)')
+ROLE = re.compile(r"rsg-[a-z0-9]+(-[a-z0-9]+)*")
+FIGURE = re.compile(r"(~\s?)?\b\d+(?:[.,]\d+)?\s?(?:ns|us|µs|ms|s|cycles|%|GB/s|MB/s)(?![\w/])")
+MEASURED = re.compile(r"\b(measured|measures|took|costs?|costing)\b", re.I)
+
+
+def sources(root, *folders):
+    for folder in folders:
+        for path in sorted((root / folder).rglob("*")):
+            if path.is_file() and path.suffix in SOURCE_SUFFIXES and "node_modules" not in path.parts:
+                yield path
+
+
+def code_of(line):
+    """The line without its // comment (string literals with // are rare enough to ignore here)."""
+    return line.split("//", 1)[0]
+
+
+def resolves(name, root, examples):
+    if name.startswith("rsg/"):
+        return (root / "include" / name).is_file()
+    if examples:
+        return False
+    if name in FASTDDSGEN or name in GENERATED:
+        return True
+    if "/" not in name or name.startswith(("src/", "include/")):
+        return False
+    base = root if name.startswith("tests/") else root / "src"
+    return (base / name).is_file() or (base / (name + ".in")).is_file()
+
+
+def check_includes(root):
+    for path in sources(root, "tests", "examples"):
+        examples = path.relative_to(root).parts[0] == "examples"
+        text = path.read_text(errors="replace")
+        for match in INCLUDE.finditer(text):
+            if not resolves(match.group(1), root, examples):
+                line = text.count("\n", 0, match.start()) + 1
+                want = "rsg/... only: an example uses the installed API" if examples else \
+                    "a path from src/ (\"gateway/config.hpp\") or the checkout (\"tests/support/vectors.hpp\")"
+                yield f"{path.relative_to(root)}:{line}: include: \"{match.group(1)}\": not {want}"
+
+
+def check_threads(root):
+    names = {}
+    for path in sources(root, "src", "include"):
+        lines = path.read_text(errors="replace").split("\n")
+        for number, line in enumerate(lines, 1):
+            if THREAD.search(code_of(line)):
+                yield f"{path.relative_to(root)}:{number}: thread: std::thread; the rule is std::jthread"
+        for name in THREAD_NAME.findall("\n".join(lines)):
+            names.setdefault(name, []).append(path.relative_to(root))
+            if not ROLE.fullmatch(name) or len(name) > 15:
+                yield f"{path.relative_to(root)}: thread-name: \"{name}\" is not rsg-<role> in 15 characters"
+        if any(JTHREAD.search(code_of(line)) for line in lines):
+            pair = [path.with_suffix(suffix) for suffix in (".hpp", ".cpp")]
+            if not any(THREAD_NAME.search(p.read_text(errors="replace")) for p in {path, *pair} if p.is_file()):
+                yield (f"{path.relative_to(root)}: thread-name: a std::jthread that does not name itself "
+                       "rsg-<role> (pthread_setname_np(::pthread_self(), \"rsg-...\") here or beside it)")
+    for name, paths in names.items():
+        if len(paths) > 1:
+            yield f"{paths[1]}: thread-name: \"{name}\" is taken already by {paths[0]}"
+
+
+def check_figures(root):
+    for path in sources(root, "src", "include"):
+        for number, line in enumerate(path.read_text(errors="replace").split("\n"), 1):
+            comment = line.split("//", 1)[1] if "//" in line else ""
+            for figure in FIGURE.finditer(comment):
+                if figure.group(1) or MEASURED.search(comment):
+                    yield (f"{path.relative_to(root)}:{number}: figure: \"{figure.group(0).strip()}\" in a comment: "
+                           "measured figures go into docs/benchmarks/, the comment points there")
+                    break
+
+
+def main():
+    root = Path(sys.argv[1] if len(sys.argv) > 1 else Path(__file__).resolve().parents[2]).resolve()
+    failures = [*check_includes(root), *check_threads(root), *check_figures(root)]
+    print("".join(f"FAIL: {failure}\n" for failure in failures) +
+          f"rules (include, thread, thread-name, figure) read over src/, include/, tests/, examples/: "
+          f"{len(failures)} broken")
+    return int(bool(failures))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
