@@ -24,7 +24,7 @@
 
 #include "gateway/clock.hpp"
 #include "gateway/log_throttle.hpp"
-#include "gateway/status/stats.hpp"
+#include "status/stats.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"

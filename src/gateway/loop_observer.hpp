@@ -4,7 +4,7 @@
 #pragma once
 
 #include "gateway/clock.hpp"
-#include "gateway/status/stats.hpp"
+#include "status/stats.hpp"
 
 namespace rsg::gateway {
 

@@ -13,7 +13,7 @@
 
 #include "gateway/clock.hpp"
 #include "gateway/latency_histogram.hpp"
-#include "gateway/status/stats.hpp"
+#include "status/stats.hpp"
 
 namespace rsg::gateway {
 

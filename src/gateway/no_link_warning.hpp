@@ -11,7 +11,7 @@
 #include <string>
 
 #include "gateway/clock.hpp"
-#include "gateway/status/stats.hpp"
+#include "status/stats.hpp"
 
 namespace rsg::gateway {
 

@@ -15,7 +15,7 @@
 
 #include "gateway/clock.hpp"
 #include "gateway/loop_observer.hpp"
-#include "gateway/status/stats.hpp"
+#include "status/stats.hpp"
 
 namespace rsg::gateway {
 

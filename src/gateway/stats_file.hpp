@@ -9,7 +9,7 @@
 #include <string>
 #include <thread>
 
-#include "gateway/status/stats.hpp"
+#include "status/stats.hpp"
 
 namespace rsg::gateway {
 

@@ -8,7 +8,7 @@
 
 #include "dds/internal/fastdds_compat.hpp"  // rename_type
 #include "gateway/ros2_type_hash.hpp"
-#include "gateway/status/status_sample.hpp"
+#include "status/status_sample.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::gateway {

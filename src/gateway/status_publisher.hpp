@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "gateway/status/stats.hpp"
+#include "status/stats.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 

@@ -9,7 +9,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <iostream>
 
-#include "gateway/status/status_sample.hpp"
+#include "status/status_sample.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"

@@ -2,7 +2,7 @@
 """The layers of CONTRIBUTING.md, checked against the code: no #include and no CMake link runs from
 a lower layer to a higher one, and gateway and tools, the two top layers, use neither each other.
 
-    wire  ->  transport, capture, mcap, foxglove  ->  dds  ->  app, gateway/status  ->  gateway, tools
+    wire  ->  transport, capture, mcap, foxglove  ->  dds  ->  app, status  ->  gateway, tools
 
 Each folder of src/ (and its include/rsg/<layer>/ headers) is a unit of the rank below; a unit may
 use a unit of a lower rank, never one of its own rank or above (transport and the DDS-free leaves
@@ -31,7 +31,7 @@ RANKS = {
     "foxglove": 1,
     "dds": 2,
     "app": 3,
-    "gateway/status": 3,  # the gateway's counters and status sample, which rsg_view reads too
+    "status": 3,  # the gateway's counters and status sample, which rsg_view reads too
     "gateway": 4,
     "tools": 4,
 }

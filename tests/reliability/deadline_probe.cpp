@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "gateway/status/status_sample.hpp"
+#include "status/status_sample.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"

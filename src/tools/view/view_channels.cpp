@@ -3,7 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/recording_schemas.hpp"
-#include "gateway/status/status_sample.hpp"
+#include "status/status_sample.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/wire/eigen.hpp"
 #include "rsg/wire/error_flags.hpp"

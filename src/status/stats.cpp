@@ -1,4 +1,4 @@
-#include "gateway/status/stats.hpp"
+#include "status/stats.hpp"
 
 #include <fmt/format.h>
 

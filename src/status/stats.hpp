@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <string>
 
-#include "gateway/status/sequence_tracker.hpp"
+#include "status/sequence_tracker.hpp"
 #include "rsg/wire/error.hpp"
 
 namespace rsg::gateway {

@@ -1,4 +1,4 @@
-#include "gateway/status/status_sample.hpp"
+#include "status/status_sample.hpp"
 
 #include <cstring>
 

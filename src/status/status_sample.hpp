@@ -3,7 +3,7 @@
 
 #include <GatewayStatus.h>
 
-#include "gateway/status/stats.hpp"
+#include "status/stats.hpp"
 
 namespace rsg::gateway {
 

@@ -1,4 +1,4 @@
-#include "gateway/status/sequence_tracker.hpp"
+#include "status/sequence_tracker.hpp"
 
 #include <algorithm>
 #include <utility>
