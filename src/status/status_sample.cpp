@@ -7,7 +7,7 @@ namespace {
 
 // The IDL names each category so that DDS tools show them, and declares them in ErrorCategory
 // order; fastddsgen lays the members out as declared, so the counters are copied as one block.
-// tests/gateway/status_sample_test.cpp checks every name against its category.
+// tests/status/status_sample_test.cpp checks every name against its category.
 static_assert(sizeof(InvalidFrameCounts) == sizeof(InvalidCounts));
 
 void copy_invalid(const InvalidCounts& counts, InvalidFrameCounts& target) {
