@@ -44,7 +44,7 @@ Egress::~Egress() {
   waitset_.detach_condition(reader_->get_statuscondition());
 }  // the owners delete the reader, then the subscriber
 
-EgressCounters Egress::counters() const {
+status::EgressCounters Egress::counters() const {
   return {samples_.load(std::memory_order_relaxed),      frames_sent_.load(std::memory_order_relaxed),
           unencodable_.load(std::memory_order_relaxed),  send_failed_.load(std::memory_order_relaxed),
           request_like_.load(std::memory_order_relaxed), rate_limited_.load(std::memory_order_relaxed)};

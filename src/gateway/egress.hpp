@@ -24,12 +24,12 @@
 
 #include "gateway/clock.hpp"
 #include "gateway/log_throttle.hpp"
-#include "status/stats.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/transport/udp_socket.hpp"
 #include "rsg/wire/frame.hpp"
+#include "status/stats.hpp"
 
 namespace rsg::gateway {
 
@@ -79,7 +79,7 @@ class Egress {
   Egress& operator=(const Egress&) = delete;
 
   /// The counters so far; safe from any thread.
-  EgressCounters counters() const;
+  status::EgressCounters counters() const;
   /// Writers of the egress topic currently matched.
   std::uint32_t matched_writers() const;
 

@@ -297,7 +297,7 @@ void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump, LoopOb
     no_link_.emplace(ingress_->local_endpoint().to_string(), start);
   }
   rate_.update(0, start);
-  const GatewayStats first = snapshot();
+  const status::GatewayStats first = snapshot();
   status_.publish(first);
   stats_file_.write_now(first);  // before READY: a stats file exists once the gateway is up
   if (metrics_) metrics_->publish(metrics_snapshot(first, start));
@@ -320,7 +320,7 @@ void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump, LoopOb
     if (dump != nullptr && dump->exchange(false)) dump_flight_recorder("signal");
     if (reload != nullptr) take_reload(*reload);
     if (now >= next_status) {
-      const GatewayStats stats = on_status_period(now);
+      const status::GatewayStats stats = on_status_period(now);
       if (observer != nullptr) observer->status(stats, ingress_.has_value());
       next_status = std::max(next_status + kStatusPeriod, now);  // after a stall, do not catch up
     }
@@ -328,14 +328,14 @@ void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump, LoopOb
   }
 
   if (observer != nullptr) observer->stopping();
-  const GatewayStats final_stats = snapshot();
+  const status::GatewayStats final_stats = snapshot();
   status_.publish(final_stats);
   stats_file_.write_now(final_stats);
   spdlog::info("stopping: {}", summary_line(final_stats));
 }
 
 void Gateway::on_link_change() {
-  const GatewayStats stats = snapshot();
+  const status::GatewayStats stats = snapshot();
   spdlog::info("link {} ({})", stats.link_up ? "up" : "down", stats.source);
   status_.publish(stats);  // now, not at the next period: readers act on link changes
   link_last_change_s_ = unix_now_s();
@@ -432,12 +432,12 @@ void Gateway::reload(const GatewayConfig& fresh) {
   spdlog::set_level(spdlog::level::from_str(log_level_name(fresh)));  // checked: any case
 }
 
-GatewayStats Gateway::on_status_period(Clock::time_point now) {
+status::GatewayStats Gateway::on_status_period(Clock::time_point now) {
   if (ingress_) {
     rate_hz_ = rate_.update(ingress_->valid_frames(), now);
     ingress_->log_rejections();
   }
-  const GatewayStats stats = snapshot();
+  const status::GatewayStats stats = snapshot();
   if (ingress_) ingress_->end_status_period();
   status_.publish(stats);
   stats_file_.post(stats);  // written by its own thread: never a disk wait here
@@ -449,8 +449,8 @@ GatewayStats Gateway::on_status_period(Clock::time_point now) {
   return stats;
 }
 
-GatewayStats Gateway::snapshot() const {
-  GatewayStats stats;
+status::GatewayStats Gateway::snapshot() const {
+  status::GatewayStats stats;
   if (ingress_) ingress_->fill(stats);
   if (egress_) {
     stats.egress = egress_->counters();
@@ -460,7 +460,7 @@ GatewayStats Gateway::snapshot() const {
   return stats;
 }
 
-MetricsSnapshot Gateway::metrics_snapshot(const GatewayStats& stats, Clock::time_point now) const {
+MetricsSnapshot Gateway::metrics_snapshot(const status::GatewayStats& stats, Clock::time_point now) const {
   MetricsSnapshot metrics;
   metrics.stats = stats;
   metrics.has_ingress = ingress_.has_value();

@@ -82,9 +82,9 @@ class Gateway {
   void on_link_change();
   void dump_flight_recorder(std::string_view reason);
   void take_reload(PendingReload& reload);
-  GatewayStats on_status_period(Clock::time_point now);  // returns the stats it reported
-  GatewayStats snapshot() const;
-  MetricsSnapshot metrics_snapshot(const GatewayStats& stats, Clock::time_point now) const;
+  status::GatewayStats on_status_period(Clock::time_point now);  // returns the stats it reported
+  status::GatewayStats snapshot() const;
+  MetricsSnapshot metrics_snapshot(const status::GatewayStats& stats, Clock::time_point now) const;
 
   GatewayConfig config_;
   dds::Participant participant_;  // first: outlives every entity below

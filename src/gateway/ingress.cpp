@@ -180,14 +180,14 @@ void Ingress::handle(const transport::DatagramBatch::Datagram& datagram, Clock::
   // counted there and goes no further: no consumer, rate topic or link state sees it. The one that
   // may start a restarted sequence is kept, to go out first should the next frame confirm it.
   switch (sequence_.observe(frame.packet_number(), robot_time_ms, arrival)) {
-    case SequenceTracker::Verdict::kOutOfSequence:
+    case status::SequenceTracker::Verdict::kOutOfSequence:
       return;
-    case SequenceTracker::Verdict::kHeld:
+    case status::SequenceTracker::Verdict::kHeld:
       held_sample_ = slot.sample();  // a plain copy into storage allocated at start-up
       held_selection_ = frame.selection();
       held_time_ms_ = robot_time_ms;
       return;
-    case SequenceTracker::Verdict::kInSequence:
+    case status::SequenceTracker::Verdict::kInSequence:
       break;
   }
   if (sequence_.counts().restarts != restarts)  // the robot's clock began again: so do the ages
@@ -250,7 +250,7 @@ void Ingress::write_rate_topics(const RobotState& sample, std::chrono::nanosecon
 }
 
 void Ingress::reject(const wire::FrameError& error, const transport::Endpoint& sender) {
-  ++counters_.invalid[invalid_index(error.category())];
+  ++counters_.invalid[status::invalid_index(error.category())];
   sequence_.on_invalid();  // counted as invalid, not also as lost
   last_rejection_ = error;
   last_rejected_sender_ = sender;
@@ -290,7 +290,7 @@ void Ingress::end_status_period() {
   age_floor_last_ns_ = std::exchange(age_floor_ns_, kNoFloor);
 }
 
-void Ingress::fill(GatewayStats& stats) const {
+void Ingress::fill(status::GatewayStats& stats) const {
   stats.ingress = counters_;
   stats.sequence = sequence_.counts();
   stats.link_up = link_.up();
@@ -314,14 +314,14 @@ void Ingress::log_rejections() {
                  last_foreign_sender_.to_string());
   logged_rejected_source_ = counters_.rejected_source;
 
-  InvalidCounts fresh{};
+  status::InvalidCounts fresh{};
   bool any = false;
   for (std::size_t i = 0; i < fresh.size(); ++i) {
     fresh[i] = counters_.invalid[i] - logged_invalid_[i];
     any |= fresh[i] != 0;
   }
   if (any)
-    spdlog::warn("rejected invalid frames: {}; the last from {}: {}: {}", format_invalid(fresh),
+    spdlog::warn("rejected invalid frames: {}; the last from {}: {}: {}", status::format_invalid(fresh),
                  last_rejected_sender_.to_string(), wire::to_string(last_rejection_.category()),
                  last_rejection_.message());
   logged_invalid_ = counters_.invalid;

@@ -23,13 +23,13 @@
 #include "gateway/ros2_standard_topics.hpp"
 #include "gateway/selection_requester.hpp"
 #include "gateway/source_filter.hpp"
-#include "status/sequence_tracker.hpp"
-#include "status/stats.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/transport/udp_socket.hpp"
 #include "rsg/wire/frame.hpp"
+#include "status/sequence_tracker.hpp"
+#include "status/stats.hpp"
 
 namespace rsg::gateway {
 
@@ -89,7 +89,7 @@ class Ingress {
   std::uint64_t valid_frames() const { return counters_.published + counters_.publish_failed; }
 
   /// Adds this side's counters to `stats`.
-  void fill(GatewayStats& stats) const;
+  void fill(status::GatewayStats& stats) const;
   /// Starts a new status period for the per-period figures (ingress_delay_us).
   void end_status_period();
 
@@ -157,8 +157,8 @@ class Ingress {
   wire::Selection held_selection_;
   std::optional<std::uint64_t> held_time_ms_;
 
-  IngressCounters counters_;
-  SequenceTracker sequence_;
+  status::IngressCounters counters_;
+  status::SequenceTracker sequence_;
   LinkMonitor link_;
   bool link_came_up_ = false;
   Clock::duration delay_period_max_{};  // arrival -> publication, this status period
@@ -178,7 +178,7 @@ class Ingress {
   transport::Endpoint source_;  // sender of the last valid frame
   wire::FrameError last_rejection_;
   transport::Endpoint last_rejected_sender_;
-  InvalidCounts logged_invalid_{};
+  status::InvalidCounts logged_invalid_{};
   std::uint64_t logged_rejected_source_ = 0;
   std::uint64_t logged_standard_dropped_ = 0;
   transport::Endpoint last_foreign_sender_;

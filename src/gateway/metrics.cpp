@@ -274,7 +274,7 @@ std::optional<ProcessFigures> read_process_figures() {
 }
 
 std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<ProcessFigures>& process) {
-  const GatewayStats& stats = snapshot.stats;
+  const status::GatewayStats& stats = snapshot.stats;
   Writer out(snapshot);
 
   out.family(kBuildInfo);
@@ -288,7 +288,7 @@ std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<
   out.family(kInvalid);
   for (std::size_t i = 0; i < stats.ingress.invalid.size(); ++i)
     out.sample(kInvalid, stats.ingress.invalid[i],
-               "category=\"" + escape_label_value(wire::to_string(category_at(i))) + '"');
+               "category=\"" + escape_label_value(wire::to_string(status::category_at(i))) + '"');
   out.one(kRejectedSource, stats.ingress.rejected_source);
   out.one(kLost, stats.sequence.lost);
   out.one(kDuplicated, stats.sequence.duplicated);

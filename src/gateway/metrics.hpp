@@ -43,7 +43,7 @@ struct DdsGuardCounts {
 
 /// What one scrape reports: the gateway's counters as of the last status period or link change.
 struct MetricsSnapshot {
-  GatewayStats stats;
+  status::GatewayStats stats;
   bool has_ingress = false;
   std::optional<DumpCounts> dumps;  ///< with a flight recorder (--pcap-ring)
   DdsGuardCounts dds_guard;

@@ -4,9 +4,9 @@
 
 namespace rsg::gateway {
 
-std::optional<std::string> NoLinkWarning::due(const GatewayStats& stats, Clock::time_point now) {
+std::optional<std::string> NoLinkWarning::due(const status::GatewayStats& stats, Clock::time_point now) {
   if (done_) return std::nullopt;
-  const IngressCounters& in = stats.ingress;
+  const status::IngressCounters& in = stats.ingress;
   if (in.published + in.publish_failed > 0) {  // a valid frame arrived: the link came up
     done_ = true;
     return std::nullopt;
@@ -18,7 +18,7 @@ std::optional<std::string> NoLinkWarning::due(const GatewayStats& stats, Clock::
     return fmt::format(
         "no valid frame on {} for {} s: {} datagrams arrived, every one rejected ({}): is the robot sending "
         "SEND_BUF frames as docs/protocol.md defines them? (rsg_frame decode shows why one fails)",
-        listen_, seconds, in.received, format_invalid(in.invalid));
+        listen_, seconds, in.received, status::format_invalid(in.invalid));
   if (in.rejected_source > 0)
     return fmt::format(
         "no datagram from an allowed source on {} for {} s: {} came from outside --allow-from (the "

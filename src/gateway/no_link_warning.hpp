@@ -22,7 +22,7 @@ class NoLinkWarning {
   NoLinkWarning(std::string listen, Clock::time_point start) : listen_(std::move(listen)), start_(start) {}
 
   /// The warning, the first time it is due: `kAfter` from start-up without a valid frame.
-  std::optional<std::string> due(const GatewayStats& stats, Clock::time_point now);
+  std::optional<std::string> due(const status::GatewayStats& stats, Clock::time_point now);
 
  private:
   std::string listen_;

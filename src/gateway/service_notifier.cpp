@@ -37,8 +37,8 @@ void ServiceNotifier::watchdog(Clock::time_point now) {
   notify("WATCHDOG=1");
 }
 
-void ServiceNotifier::status(const GatewayStats& stats, bool has_ingress) {
-  IngressCounters period;
+void ServiceNotifier::status(const status::GatewayStats& stats, bool has_ingress) {
+  status::IngressCounters period;
   period.rejected_source = stats.ingress.rejected_source - last_.rejected_source;
   for (std::size_t i = 0; i < period.invalid.size(); ++i)
     period.invalid[i] = stats.ingress.invalid[i] - last_.invalid[i];
@@ -48,7 +48,8 @@ void ServiceNotifier::status(const GatewayStats& stats, bool has_ingress) {
 
 void ServiceNotifier::stopping() { notify("STOPPING=1"); }
 
-std::string service_status_line(const GatewayStats& stats, bool has_ingress, const IngressCounters& period) {
+std::string service_status_line(const status::GatewayStats& stats, bool has_ingress,
+                                const status::IngressCounters& period) {
   const std::uint32_t readers = stats.state_readers + stats.standard_readers;
   std::string line;
   if (has_ingress) {
@@ -60,7 +61,7 @@ std::string service_status_line(const GatewayStats& stats, bool has_ingress, con
       causes = fmt::format("ignoring {} datagrams/s from outside --allow-from", period.rejected_source);
     if (const std::uint64_t invalid = period.invalid_total(); invalid > 0)
       causes += fmt::format("{}rejecting {} invalid frames/s ({})", causes.empty() ? "" : ", ", invalid,
-                            format_invalid(period.invalid));
+                            status::format_invalid(period.invalid));
     if (!causes.empty()) line += (stats.link_up ? ", " : ": ") + causes;
   } else {
     line = fmt::format("egress only, {} sent", stats.egress.frames_sent);

@@ -23,8 +23,8 @@ namespace rsg::gateway {
 /// `period`, the ingress counters' increase over the last status period (1 s), it names what keeps
 /// a link down or what goes on beside it: "link down: ignoring 1000 datagrams/s from outside
 /// --allow-from, 0 readers", "link down: rejecting 1000 invalid frames/s (bad_crc=1000), 0 readers".
-std::string service_status_line(const GatewayStats& stats, bool has_ingress,
-                                const IngressCounters& period = {});
+std::string service_status_line(const status::GatewayStats& stats, bool has_ingress,
+                                const status::IngressCounters& period = {});
 
 class ServiceNotifier : public LoopObserver {
  public:
@@ -33,12 +33,12 @@ class ServiceNotifier : public LoopObserver {
 
   // The gateway loop's events: READY=1 with the first STATUS=, STATUS= each period, WATCHDOG=1
   // from each turn (at most every half interval), STOPPING=1.
-  void started(const GatewayStats& stats, bool has_ingress) override {
+  void started(const status::GatewayStats& stats, bool has_ingress) override {
     last_ = stats.ingress;
     ready(service_status_line(stats, has_ingress));
   }
   void turned(Clock::time_point now) override { watchdog(now); }
-  void status(const GatewayStats& stats, bool has_ingress) override;
+  void status(const status::GatewayStats& stats, bool has_ingress) override;
   void stopping() override;
 
   /// True when a service manager listens (NOTIFY_SOCKET is set).
@@ -59,8 +59,8 @@ class ServiceNotifier : public LoopObserver {
   bool active_ = false;
   std::optional<Clock::duration> watchdog_;
   std::optional<Clock::time_point> last_ping_;
-  bool failed_ = false;   // a notification failed: said once, not every time
-  IngressCounters last_;  // as of the last status line: the next one tells what changed since
+  bool failed_ = false;           // a notification failed: said once, not every time
+  status::IngressCounters last_;  // as of the last status line: the next one tells what changed since
 };
 
 }  // namespace rsg::gateway

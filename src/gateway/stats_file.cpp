@@ -18,7 +18,7 @@ StatsFile::StatsFile(std::string path) : path_(std::move(path)) {
 // std::jthread asks run() to stop and joins it; run() writes what is pending first.
 StatsFile::~StatsFile() = default;
 
-void StatsFile::write_now(const GatewayStats& stats) {
+void StatsFile::write_now(const status::GatewayStats& stats) {
   if (path_.empty()) return;
   const std::lock_guard file(file_mutex_);
   {
@@ -28,7 +28,7 @@ void StatsFile::write_now(const GatewayStats& stats) {
   write(stats);
 }
 
-void StatsFile::post(const GatewayStats& stats) {
+void StatsFile::post(const status::GatewayStats& stats) {
   if (path_.empty()) return;
   {
     const std::lock_guard lock(pending_mutex_);
@@ -48,7 +48,7 @@ void StatsFile::run(const std::stop_token& stop) {
     // The file first, then what is pending: a write_now() in between has taken it, and older stats
     // are never written after newer ones.
     const std::lock_guard file(file_mutex_);
-    std::optional<GatewayStats> stats;
+    std::optional<status::GatewayStats> stats;
     {
       const std::lock_guard lock(pending_mutex_);
       stats.swap(pending_);
@@ -57,7 +57,7 @@ void StatsFile::run(const std::stop_token& stop) {
   }
 }
 
-void StatsFile::write(const GatewayStats& stats) {
+void StatsFile::write(const status::GatewayStats& stats) {
   const std::string partial = path_ + ".partial";
   const std::string text = to_json(stats) + '\n';
   const auto failed = [&](const std::string& file) {

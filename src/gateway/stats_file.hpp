@@ -29,23 +29,23 @@ class StatsFile {
 
   /// Writes `stats` now, on the calling thread (the first file before READY, the last at stop);
   /// anything posted before and not yet written is dropped, never written after it.
-  void write_now(const GatewayStats& stats);
+  void write_now(const status::GatewayStats& stats);
 
   /// Hands `stats` to the writer thread and returns at once; a later post replaces one not yet
   /// written.
-  void post(const GatewayStats& stats);
+  void post(const status::GatewayStats& stats);
 
  private:
   void run(const std::stop_token& stop);
-  void write(const GatewayStats& stats);  // with file_mutex_ held
+  void write(const status::GatewayStats& stats);  // with file_mutex_ held
 
   const std::string path_;
   std::mutex file_mutex_;  // one write of the file at a time, in the order of the calls
   int last_errno_ = 0;     // of the last failed write; 0: it worked (guarded by file_mutex_)
   std::mutex pending_mutex_;
   std::condition_variable_any posted_;
-  std::optional<GatewayStats> pending_;  // guarded by pending_mutex_
-  std::jthread thread_;                  // last: started once everything it uses exists
+  std::optional<status::GatewayStats> pending_;  // guarded by pending_mutex_
+  std::jthread thread_;                          // last: started once everything it uses exists
 };
 
 }  // namespace rsg::gateway

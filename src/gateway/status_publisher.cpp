@@ -8,8 +8,8 @@
 
 #include "dds/internal/fastdds_compat.hpp"  // rename_type
 #include "gateway/ros2_type_hash.hpp"
-#include "status/status_sample.hpp"
 #include "rsg/error.hpp"
+#include "status/status_sample.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;
@@ -29,7 +29,7 @@ StatusPublisher::StatusPublisher(dds::Participant& participant, const std::strin
 
 StatusPublisher::~StatusPublisher() = default;  // the owners delete the writer, then the publisher
 
-void StatusPublisher::publish(const GatewayStats& stats) {
+void StatusPublisher::publish(const status::GatewayStats& stats) {
   to_status_sample(stats, sample_);
   if (!dds::succeeded(writer_->write(&sample_))) spdlog::warn("could not write the gateway status");
 }

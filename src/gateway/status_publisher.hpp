@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "status/stats.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
+#include "status/stats.hpp"
 
 namespace rsg::gateway {
 
@@ -23,7 +23,7 @@ class StatusPublisher {
   StatusPublisher(const StatusPublisher&) = delete;
   StatusPublisher& operator=(const StatusPublisher&) = delete;
 
-  void publish(const GatewayStats& stats);
+  void publish(const status::GatewayStats& stats);
 
  private:
   dds::Participant& participant_;

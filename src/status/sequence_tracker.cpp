@@ -5,7 +5,7 @@
 
 #include "rsg/wire/frame.hpp"
 
-namespace rsg::gateway {
+namespace rsg::status {
 namespace {
 
 constexpr unsigned kModulo = wire::kPacketNumberModulo;
@@ -187,4 +187,4 @@ void SequenceTracker::arrive_late(unsigned age) noexcept {
   }
 }
 
-}  // namespace rsg::gateway
+}  // namespace rsg::status

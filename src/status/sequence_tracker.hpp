@@ -60,7 +60,7 @@
 #include <cstdint>
 #include <optional>
 
-namespace rsg::gateway {
+namespace rsg::status {
 
 class SequenceTracker {
  public:
@@ -145,4 +145,4 @@ class SequenceTracker {
   bool releases_held_ = false;
 };
 
-}  // namespace rsg::gateway
+}  // namespace rsg::status

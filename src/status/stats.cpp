@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 
-namespace rsg::gateway {
+namespace rsg::status {
 
 std::uint64_t IngressCounters::invalid_total() const {
   return std::accumulate(invalid.begin(), invalid.end(), std::uint64_t{0});
@@ -78,4 +78,4 @@ std::string summary_line(const GatewayStats& stats) {
   return line;
 }
 
-}  // namespace rsg::gateway
+}  // namespace rsg::status

@@ -9,10 +9,10 @@
 #include <cstdint>
 #include <string>
 
-#include "status/sequence_tracker.hpp"
 #include "rsg/wire/error.hpp"
+#include "status/sequence_tracker.hpp"
 
-namespace rsg::gateway {
+namespace rsg::status {
 
 /// Per spec validation category (ErrorCategory::kTruncated first), `kNone` excluded.
 using InvalidCounts = std::array<std::uint64_t, wire::kErrorCategoryCount>;
@@ -75,4 +75,4 @@ std::string summary_line(const GatewayStats& stats);
 /// "bad_crc=3 truncated=1": the non-zero counts of `counts`, in category order.
 std::string format_invalid(const InvalidCounts& counts);
 
-}  // namespace rsg::gateway
+}  // namespace rsg::status

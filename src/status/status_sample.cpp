@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-namespace rsg::gateway {
+namespace rsg::status {
 namespace {
 
 // The IDL names each category so that DDS tools show them, and declares them in ErrorCategory
@@ -80,4 +80,4 @@ GatewayStats from_status_sample(const GatewayStatus& sample) {
   return stats;
 }
 
-}  // namespace rsg::gateway
+}  // namespace rsg::status

@@ -5,7 +5,7 @@
 
 #include "status/stats.hpp"
 
-namespace rsg::gateway {
+namespace rsg::status {
 
 /// Fills every member of `sample`; a source address longer than the IDL bound is cut.
 void to_status_sample(const GatewayStats& stats, GatewayStatus& sample);
@@ -13,4 +13,4 @@ void to_status_sample(const GatewayStats& stats, GatewayStatus& sample);
 /// The reverse, for monitors that read the status topic.
 GatewayStats from_status_sample(const GatewayStatus& sample);
 
-}  // namespace rsg::gateway
+}  // namespace rsg::status

@@ -129,10 +129,11 @@ class IngressAllocation : public ::testing::Test {
   //
   // With `recorder`, the gateway's flight recorder runs too. `check_after` gets the ingress after
   // the last frame, with every datagram sent in order.
-  GatewayStats stream(const std::string& writer_profile, fdds::ReliabilityQosPolicyKind reliability,
-                      std::optional<FlightRecorder::Options> recorder = std::nullopt,
-                      const std::function<void(Ingress&, const std::vector<std::span<const std::uint8_t>>&)>&
-                          check_after = {}) {
+  status::GatewayStats stream(
+      const std::string& writer_profile, fdds::ReliabilityQosPolicyKind reliability,
+      std::optional<FlightRecorder::Options> recorder = std::nullopt,
+      const std::function<void(Ingress&, const std::vector<std::span<const std::uint8_t>>&)>& check_after =
+          {}) {
     Ingress::Options ingress_options = options(writer_profile);
     ingress_options.flight_recorder = recorder;
     Ingress ingress(publishing_, ingress_options);
@@ -145,7 +146,7 @@ class IngressAllocation : public ::testing::Test {
         subscribing_.robot_state_topic(topic_, type_name_), reader_qos);
     EXPECT_NE(reader, nullptr);
     const auto stats = [&] {
-      GatewayStats now;
+      status::GatewayStats now;
       ingress.fill(now);  // once a second in the gateway, and allowed to allocate: not counted
       return now;
     };
@@ -182,11 +183,11 @@ class IngressAllocation : public ::testing::Test {
       } while (stats().ingress.received < received);
     }
 
-    const GatewayStats final_stats = stats();
+    const status::GatewayStats final_stats = stats();
     EXPECT_EQ(final_stats.ingress.received, received);
     const std::uint64_t corrupted = frames.size() / kCorruptEvery;
-    EXPECT_EQ(final_stats.ingress.invalid[invalid_index(wire::ErrorCategory::kBadCrc)], corrupted);
-    EXPECT_EQ(final_stats.ingress.invalid[invalid_index(wire::ErrorCategory::kLengthMismatch)],
+    EXPECT_EQ(final_stats.ingress.invalid[status::invalid_index(wire::ErrorCategory::kBadCrc)], corrupted);
+    EXPECT_EQ(final_stats.ingress.invalid[status::invalid_index(wire::ErrorCategory::kLengthMismatch)],
               received - frames.size());
     EXPECT_EQ(final_stats.ingress.published, frames.size() - corrupted);
     EXPECT_EQ(callbacks_, frames.size() - corrupted) << "the callback must see every valid frame, only those";
@@ -296,7 +297,7 @@ TEST_F(IngressAllocation, WithTheRos2StandardTopicsOnNothingAllocates) {
              std::this_thread::sleep_for(10ms);
            EXPECT_EQ(topics->written()[0] + topics->dropped(), valid);
            // Only the ingress thread drops, and it is done: the status carries the final count.
-           GatewayStats now;
+           status::GatewayStats now;
            ingress.fill(now);
            EXPECT_EQ(now.standard_dropped, topics->dropped());
            EXPECT_GT(topics->written()[0], 0U);

@@ -23,8 +23,8 @@ MetricsSnapshot example() {
   auto& stats = snapshot.stats;
   stats.ingress.received = 1200;
   stats.ingress.published = 1000;
-  stats.ingress.invalid[invalid_index(wire::ErrorCategory::kBadCrc)] = 150;
-  stats.ingress.invalid[invalid_index(wire::ErrorCategory::kTruncated)] = 50;
+  stats.ingress.invalid[status::invalid_index(wire::ErrorCategory::kBadCrc)] = 150;
+  stats.ingress.invalid[status::invalid_index(wire::ErrorCategory::kTruncated)] = 50;
   stats.ingress.rejected_source = 7;
   stats.sequence.lost = 3;
   stats.egress.frames_sent = 42;
@@ -94,7 +94,7 @@ TEST(Metrics, FlightRecorderDumpsHaveOneSeriesPerResult) {
 TEST(Metrics, InvalidFramesHaveOneSeriesPerSpecCategoryZerosIncluded) {
   const auto values = samples(format_metrics(example(), std::nullopt));
   for (std::size_t i = 0; i < wire::kErrorCategoryCount; ++i) {
-    const auto category = category_at(i);
+    const auto category = status::category_at(i);
     const std::string expected = category == wire::ErrorCategory::kBadCrc      ? "150"
                                  : category == wire::ErrorCategory::kTruncated ? "50"
                                                                                : "0";

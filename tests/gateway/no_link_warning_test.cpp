@@ -10,7 +10,7 @@ const Clock::time_point kStart{seconds(1000)};
 
 TEST(NoLinkWarning, SaysOnceAfterTenSecondsThatNoDatagramArrived) {
   NoLinkWarning warning("0.0.0.0:17000", kStart);
-  const GatewayStats silent;
+  const status::GatewayStats silent;
   EXPECT_FALSE(warning.due(silent, kStart + seconds(9)));
   const auto said = warning.due(silent, kStart + seconds(10));
   ASSERT_TRUE(said);
@@ -22,10 +22,10 @@ TEST(NoLinkWarning, SaysOnceAfterTenSecondsThatNoDatagramArrived) {
 
 TEST(NoLinkWarning, DatagramsThatAreNoFramesAreCountedByCategory) {
   NoLinkWarning warning("127.0.0.1:17000", kStart);
-  GatewayStats stats;
+  status::GatewayStats stats;
   stats.ingress.received = 12;
-  stats.ingress.invalid[invalid_index(wire::ErrorCategory::kBadCrc)] = 10;
-  stats.ingress.invalid[invalid_index(wire::ErrorCategory::kLengthMismatch)] = 2;
+  stats.ingress.invalid[status::invalid_index(wire::ErrorCategory::kBadCrc)] = 10;
+  stats.ingress.invalid[status::invalid_index(wire::ErrorCategory::kLengthMismatch)] = 2;
   const auto said = warning.due(stats, kStart + seconds(11));
   ASSERT_TRUE(said);
   EXPECT_EQ(
@@ -37,7 +37,7 @@ TEST(NoLinkWarning, DatagramsThatAreNoFramesAreCountedByCategory) {
 
 TEST(NoLinkWarning, DatagramsFromOutsideAllowFromAreNamedAsSuch) {
   NoLinkWarning warning("127.0.0.1:17000", kStart);
-  GatewayStats stats;
+  status::GatewayStats stats;
   stats.ingress.rejected_source = 7;
   const auto said = warning.due(stats, kStart + seconds(10));
   ASSERT_TRUE(said);
@@ -46,11 +46,11 @@ TEST(NoLinkWarning, DatagramsFromOutsideAllowFromAreNamedAsSuch) {
 
 TEST(NoLinkWarning, NeverSaysAnythingOnceAFrameWasValid) {
   NoLinkWarning warning("127.0.0.1:17000", kStart);
-  GatewayStats stats;
+  status::GatewayStats stats;
   stats.ingress.received = 1;
   stats.ingress.published = 1;
   EXPECT_FALSE(warning.due(stats, kStart + seconds(1)));
-  EXPECT_FALSE(warning.due(GatewayStats{}, kStart + seconds(60)));  // a link that went down later
+  EXPECT_FALSE(warning.due(status::GatewayStats{}, kStart + seconds(60)));  // a link that went down later
 }
 
 }  // namespace

@@ -59,8 +59,8 @@ class NotifySocket {
   int fd_ = -1;
 };
 
-GatewayStats streaming() {
-  GatewayStats stats;
+status::GatewayStats streaming() {
+  status::GatewayStats stats;
   stats.link_up = true;
   stats.source = "127.0.0.1:40000";
   stats.rate_hz = 1000;
@@ -83,7 +83,7 @@ TEST(ServiceNotifier, StartedSendsReadyWithAStatusLine) {
   ASSERT_TRUE(notifier.active());
   notifier.started(streaming(), true);
   EXPECT_EQ(socket.next(), "READY=1\nSTATUS=link up from 127.0.0.1:40000 at 1000.0 Hz, 2 readers");
-  GatewayStats down;
+  status::GatewayStats down;
   notifier.status(down, true);
   EXPECT_EQ(socket.next(), "STATUS=link down, 0 readers");
   notifier.stopping();
@@ -93,7 +93,7 @@ TEST(ServiceNotifier, StartedSendsReadyWithAStatusLine) {
 TEST(ServiceNotifier, TheStatusLineNamesWhatKeepsTheLinkDown) {
   NotifySocket socket;
   ServiceNotifier notifier;
-  GatewayStats stats;
+  status::GatewayStats stats;
   stats.ingress.rejected_source = 5;  // before the start: not this period's
   notifier.started(stats, true);
   EXPECT_EQ(socket.next(), "READY=1\nSTATUS=link down, 0 readers");
@@ -101,12 +101,12 @@ TEST(ServiceNotifier, TheStatusLineNamesWhatKeepsTheLinkDown) {
   notifier.status(stats, true);
   EXPECT_EQ(socket.next(),
             "STATUS=link down: ignoring 1000 datagrams/s from outside --allow-from, 0 readers");
-  stats.ingress.invalid[invalid_index(wire::ErrorCategory::kBadCrc)] += 20;
+  stats.ingress.invalid[status::invalid_index(wire::ErrorCategory::kBadCrc)] += 20;
   notifier.status(stats, true);
   EXPECT_EQ(socket.next(), "STATUS=link down: rejecting 20 invalid frames/s (bad_crc=20), 0 readers");
   notifier.status(stats, true);  // nothing new: nothing to name
   EXPECT_EQ(socket.next(), "STATUS=link down, 0 readers");
-  GatewayStats up = streaming();
+  status::GatewayStats up = streaming();
   up.ingress = stats.ingress;
   up.ingress.rejected_source += 3;
   notifier.status(up, true);

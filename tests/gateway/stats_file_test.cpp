@@ -15,8 +15,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-GatewayStats published(std::uint64_t count) {
-  GatewayStats stats;
+status::GatewayStats published(std::uint64_t count) {
+  status::GatewayStats stats;
   stats.ingress.published = count;
   return stats;
 }

@@ -9,10 +9,10 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <iostream>
 
-#include "status/status_sample.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
+#include "status/status_sample.hpp"
 
 int main(int argc, char** argv) {
   int domain = 0;
@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
     waitset.wait(triggered, rsg::dds::Duration(0, 200'000'000));
     while (reader->take_next_sample(&sample, &info) == rsg::dds::kOk)
       if (info.valid_data)
-        std::cout << rsg::gateway::to_json(rsg::gateway::from_status_sample(sample)) << std::endl;
+        std::cout << rsg::status::to_json(rsg::status::from_status_sample(sample)) << std::endl;
   }
   waitset.detach_condition(reader->get_statuscondition());
   return 0;

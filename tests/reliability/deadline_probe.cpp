@@ -24,11 +24,11 @@
 #include <string>
 #include <vector>
 
-#include "status/status_sample.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
+#include "status/status_sample.hpp"
 
 namespace {
 
@@ -101,7 +101,7 @@ class StatusListener : public fdds::DataReaderListener {
     while (reader->take_next_sample(&sample_, &info) == rsg::dds::kOk) {
       if (!info.valid_data) continue;
       // The --stats-file object without its braces, appended after "t" and "event".
-      const std::string json = rsg::gateway::to_json(rsg::gateway::from_status_sample(sample_));
+      const std::string json = rsg::status::to_json(rsg::status::from_status_sample(sample_));
       log_.add(timestamped("status", "," + json.substr(1, json.size() - 2)));
     }
   }

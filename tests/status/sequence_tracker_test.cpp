@@ -7,7 +7,7 @@
 #include <random>
 #include <vector>
 
-namespace rsg::gateway {
+namespace rsg::status {
 namespace {
 
 using namespace std::chrono_literals;
@@ -458,4 +458,4 @@ TEST(SequenceTracker, InvalidFramesBeforeTheFirstValidOneCountNothing) {
 }
 
 }  // namespace
-}  // namespace rsg::gateway
+}  // namespace rsg::status

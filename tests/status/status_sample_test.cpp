@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace rsg::gateway {
+namespace rsg::status {
 namespace {
 
 GatewayStats distinct_stats() {
@@ -115,4 +115,4 @@ TEST(StatsSummary, NamesOnlyTheCategoriesThatOccurred) {
 }
 
 }  // namespace
-}  // namespace rsg::gateway
+}  // namespace rsg::status

@@ -3,10 +3,10 @@
 #include <nlohmann/json.hpp>
 
 #include "app/recording_schemas.hpp"
-#include "status/status_sample.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/wire/eigen.hpp"
 #include "rsg/wire/error_flags.hpp"
+#include "status/status_sample.hpp"
 
 namespace rsg::tools::view {
 namespace {
@@ -78,7 +78,7 @@ std::optional<std::string> frame_transform_json(const RobotState& sample, std::u
 }
 
 std::string status_json(const GatewayStatus& sample) {
-  return gateway::to_json(gateway::from_status_sample(sample));
+  return status::to_json(status::from_status_sample(sample));
 }
 
 void PageSummary::add(const RobotState& sample) {
