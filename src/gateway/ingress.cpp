@@ -5,7 +5,7 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 
 #include "dds/internal/fastdds_compat.hpp"  // is_plain
-#include "gateway/ros2_type_hash.hpp"
+#include "gateway/no_reader_filters.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;

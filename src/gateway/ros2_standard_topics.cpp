@@ -9,7 +9,7 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <stdexcept>
 
-#include "gateway/ros2_type_hash.hpp"
+#include "gateway/no_reader_filters.hpp"
 #include "rsg/error.hpp"
 #include "rsg/wire/eigen.hpp"
 
@@ -101,12 +101,8 @@ Ros2StandardTopics::~Ros2StandardTopics() {
 void Ros2StandardTopics::create(Writer& writer, const std::optional<Output>& output, fdds::TypeSupport type) {
   if (!output) return;
   fdds::Topic* topic = participant_.topic(output->topic, type);
-  fdds::DataWriterQos qos = writer_qos(publisher_);
-  announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
-  // As every writer of the gateway (create_writer_with_profile): no reader's filter runs here.
-  rsg::dds::leave_filtering_to_readers(qos);
-  writer.writer =
-      dds::own(publisher_, publisher_.create_datawriter(topic, qos), "the writer of '" + output->topic + "'");
+  writer.writer = dds::own(publisher_, create_writer(publisher_, topic, writer_qos(publisher_)),
+                           "the writer of '" + output->topic + "'");
   writer.decimator.emplace(output->decimation);
 }
 

@@ -5,8 +5,6 @@
 #pragma once
 
 #include <fastdds/dds/core/policy/QosPolicies.hpp>
-#include <fastdds/dds/publisher/DataWriter.hpp>
-#include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
@@ -16,7 +14,6 @@
 
 #include "gateway/ros2_type_hashes.hpp"
 #include "rsg/dds/fastdds.hpp"
-#include "rsg/dds/views.hpp"
 
 namespace rsg::gateway {
 
@@ -43,20 +40,6 @@ inline void announce_ros2_type_hash(eprosima::fastdds::dds::UserDataQosPolicy& u
   if (hash.empty()) return;
   const std::string text = "typehash=" + std::string(hash) + ";";
   user_data.setValue(std::vector<rsg::dds::rtps::octet>(text.begin(), text.end()));
-}
-
-/// create_datawriter_with_profile, with the topic type's hash announced when it has one, and
-/// content filtering left to the readers (rsg::dds::leave_filtering_to_readers: no reader's filter
-/// may run on the gateway's ingress thread).
-/// @return nullptr when the profile is unknown or Fast DDS refuses the writer.
-inline eprosima::fastdds::dds::DataWriter* create_writer_with_profile(
-    eprosima::fastdds::dds::Publisher& publisher, eprosima::fastdds::dds::Topic* topic,
-    const std::string& profile) {
-  eprosima::fastdds::dds::DataWriterQos qos;
-  if (publisher.get_datawriter_qos_from_profile(profile, qos) != rsg::dds::kOk) return nullptr;
-  announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
-  rsg::dds::leave_filtering_to_readers(qos);
-  return publisher.create_datawriter(topic, qos);
 }
 
 /// create_datareader_with_profile, with the topic type's hash announced when it has one.

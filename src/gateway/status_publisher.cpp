@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "dds/internal/fastdds_compat.hpp"  // rename_type
-#include "gateway/ros2_type_hash.hpp"
+#include "gateway/no_reader_filters.hpp"
 #include "rsg/error.hpp"
 #include "status/status_sample.hpp"
 
