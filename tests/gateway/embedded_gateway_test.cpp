@@ -10,10 +10,12 @@
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <mutex>
 #include <random>
+#include <set>
 #include <thread>
 
 #include "dds/internal/fastdds_compat.hpp"
@@ -156,6 +158,37 @@ TEST_F(EmbeddedGatewayTest, NoCallbackAfterStop) {
   robot.send_to(frame, to);  // the port is closed: may be refused
   std::this_thread::sleep_for(50ms);
   EXPECT_EQ(calls.load(), 0);
+}
+
+// The names of this process's threads, as top -H and tests/integration/thread_freeze.py read them.
+std::set<std::string> thread_names() {
+  std::set<std::string> names;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream comm(task.path() / "comm");
+    std::string name;
+    if (std::getline(comm, name)) names.insert(name);
+  }
+  return names;
+}
+
+TEST_F(EmbeddedGatewayTest, EveryThreadOfTheGatewayNamesItselfByItsRole) {
+  const std::string stats_file = ::testing::TempDir() + "rsg_embedded_threads_" + std::to_string(::getpid());
+  gateway::EmbeddedGateway gateway(config(domain_, "embedded_threads", stats_file) +
+                                       "egress-topic: embedded_threads_cmd\nsend-to: [127.0.0.1:9]\n"
+                                       "metrics: 127.0.0.1:0\njoint-states: 10\n",
+                                   [](const RobotState&) {});
+  const std::set<std::string> expected{"rsg-ingress", "rsg-stats", "rsg-egress", "rsg-metrics",
+                                       "rsg-ros2-topics"};
+  std::set<std::string> missing = expected;
+  // Each thread names itself first thing; give them a moment to have started.
+  for (int attempt = 0; attempt < 100 && !missing.empty(); ++attempt) {
+    const std::set<std::string> names = thread_names();
+    std::erase_if(missing, [&](const std::string& name) { return names.contains(name); });
+    if (!missing.empty()) std::this_thread::sleep_for(20ms);
+  }
+  EXPECT_TRUE(missing.empty()) << "threads not found by name: " << ::testing::PrintToString(missing);
+  gateway.stop();
+  std::remove(stats_file.c_str());
 }
 
 TEST_F(EmbeddedGatewayTest, UnusableConfigurationThrowsNamingTheProblem) {
