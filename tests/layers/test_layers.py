@@ -36,15 +36,9 @@ RANKS = {
     "tools": 4,
 }
 
-# Headers the build generates. fastddsgen's type support is included by its bare name, as the
-# generated code includes itself (and as a consumer of the installed rsg/idl/ does); rsg's own
-# generated headers are included by their path from src/, as if they were there (the build writes
-# them into the build tree's mirror of src/, next to their template when they have one).
-FASTDDSGEN = {
-    "RobotState.h": "dds", "RobotStatePubSubTypes.h": "dds", "RobotStateTypeObject.h": "dds",
-    "GatewayStatus.h": "dds", "GatewayStatusPubSubTypes.h": "dds", "GatewayStatusTypeObject.h": "dds",
-    "StandardMessages.h": "gateway", "StandardMessagesPubSubTypes.h": "gateway",
-}
+# Headers the build generates without a template beside them in src/, by their path from src/ (the
+# build writes them into the build tree's mirror of src/). fastddsgen's type support is not among
+# them: it is a system header to rsg's code, included as <RobotState.h>.
 GENERATED = {
     "gateway/ros2_type_hashes.hpp",  # cmake/rsg_ros2_type_hashes.cmake, from ros2/type_hashes.py
 }
@@ -73,8 +67,6 @@ def resolve(name, root):
         if target.is_file():
             return unit_of(target, root), None
         return None, "no such header in include/"
-    if name in FASTDDSGEN:
-        return FASTDDSGEN[name], None
     if "/" not in name:
         return None, "a bare name: write the header's path from src/"
     target = root / "src" / name
@@ -95,7 +87,7 @@ def include_edges(root):
         installed = path.relative_to(root).parts[0] == "include"
         for name in re.findall(r'^\s*#\s*include\s+"([^"]+)"', path.read_text(errors="replace"), re.M):
             target_unit, why = resolve(name, root)
-            if why is None and installed and not name.startswith("rsg/") and name not in FASTDDSGEN:
+            if why is None and installed and not name.startswith("rsg/"):
                 why = "an installed header includes one that is not installed"
             if why is not None:
                 unresolved.append(f"{path.relative_to(root)}: #include \"{name}\": {why}")

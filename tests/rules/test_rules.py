@@ -22,10 +22,6 @@ from pathlib import Path
 
 SOURCE_SUFFIXES = {".hpp", ".cpp", ".h", ".cc", ".c", ".in"}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
-# fastddsgen's type support, included by its bare name (CONTRIBUTING.md, "One include root").
-FASTDDSGEN = {"RobotState.h", "RobotStatePubSubTypes.h", "RobotStateTypeObject.h", "GatewayStatus.h",
-              "GatewayStatusPubSubTypes.h", "GatewayStatusTypeObject.h", "StandardMessages.h",
-              "StandardMessagesPubSubTypes.h"}
 # Headers the build writes into its mirror of src/ or tests/ without a template beside them.
 GENERATED = {"gateway/ros2_type_hashes.hpp", "tests/ros2/ros2_layout.hpp"}
 THREAD = re.compile(r"\bstd::thread\b")
@@ -53,7 +49,7 @@ def resolves(name, root, examples):
         return (root / "include" / name).is_file()
     if examples:
         return False
-    if name in FASTDDSGEN or name in GENERATED:
+    if name in GENERATED:
         return True
     if "/" not in name or name.startswith(("src/", "include/")):
         return False
