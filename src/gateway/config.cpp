@@ -123,7 +123,8 @@ const std::array kKeys = {
           for (const auto& value : c.rate_topics) {
             const auto rate = parse_rate_topic(value);
             if (!rate)
-              return "'" + value + "' is not NAME:HZ with HZ in (0, 10000] nor NAME:every:N with N in 1..1000000";
+              return "'" + value +
+                     "' is not NAME:HZ with HZ in (0, 10000] nor NAME:every:N with N in 1..1000000";
             if (!names.insert(rate->name).second) return "'" + rate->name + "' is given twice";
           }
           return std::string();
