@@ -38,7 +38,8 @@ def build_example(h, env):
                   "-DCMAKE_CXX_COMPILER_LAUNCHER=ccache", "-DCMAKE_C_COMPILER_LAUNCHER=ccache"],
                  ["cmake", "--build", str(tree)]):
         done = subprocess.run(step, env=shell, capture_output=True, text=True)
-        (h.dir / "example_build.log").open("a").write(done.stdout + done.stderr)
+        with (h.dir / "example_build.log").open("a") as log:
+            log.write(done.stdout + done.stderr)
         check(done.returncode == 0, f"{' '.join(step[:3])}: failed, see {h.dir / 'example_build.log'}:\n"
                                     f"{(done.stdout + done.stderr)[-3000:]}")
     return tree / "rsg_ros2_node", prefix
