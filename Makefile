@@ -192,9 +192,11 @@ IMAGE ?= rsg
 image:
 	docker/build-image.sh $(IMAGE)
 
-# Builds the image, then runs the pipeline, rsg_view and docker/compose.yaml in containers.
-test-image: deps
-	RSG_IMAGE=$(IMAGE) tests/image/run.sh
+# Builds the image from make package's Release tree (docker/build-image.sh --tools-from: the
+# binaries the .deb holds, compiled once for both), then runs the pipeline, rsg_view and
+# docker/compose.yaml in containers. make image compiles in the Dockerfile's build stage instead.
+test-image: deps package
+	RSG_IMAGE=$(IMAGE) RSG_IMAGE_TOOLS_FROM=$(PKG_BUILD) tests/image/run.sh
 
 # The Debian package (cmake/rsg_package.cmake, docs/service.md): a Release build of its own without
 # the tests, the man pages from help2man, CPack's DEB generator (version: project(), Depends:

@@ -4,7 +4,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 image=${RSG_IMAGE:-rsg}
-docker/build-image.sh "$image"
+# RSG_IMAGE_TOOLS_FROM: a Release tree without tests to install instead of compiling in the image.
+docker/build-image.sh ${RSG_IMAGE_TOOLS_FROM:+--tools-from "$RSG_IMAGE_TOOLS_FROM"} "$image"
 source docker/engine.sh
 # Debian's Python: its python3-yaml reads compose.yaml (make deps installs it).
 exec /usr/bin/python3 tests/image/test_image.py --engine "${ENGINE[*]}" --image "$image" "$@"
