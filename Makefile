@@ -87,7 +87,7 @@ build: deps-run
 # The product and every test and benchmark, with everything the tests need (make deps).
 build-tests: deps
 	cmake -S . -B $(BUILD) $(call generator,$(BUILD)) $(OPT_FLAGS) -DRSG_BUILD_TESTS=ON $(CMAKE_COMMON)
-	cmake --build $(BUILD) -j $(JOBS)
+	cmake --build $(BUILD) -j $(JOBS) && echo "build-tests: $(BUILD) built in $$SECONDS s"
 
 # Tools, profiles, IDL, client libraries and headers, and the CMake package (find_package(rsg)).
 # PREFIX defaults to CMake's (/usr/local): make install PREFIX=/opt/rsg
@@ -98,12 +98,13 @@ install: build
 unit-asan: deps
 	cmake -S . -B $(ASAN_BUILD) $(call generator,$(ASAN_BUILD)) -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-g1 -DCMAKE_C_FLAGS_DEBUG=-g1 \
 	      -DRSG_SANITIZE=ON $(CMAKE_COMMON)
-	cmake --build $(ASAN_BUILD) -j $(JOBS) --target unit_tests
-	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) ctest --output-on-failure -j $(CTEST_JOBS) -L unit 2>&1 | tee ctest.log
+	cmake --build $(ASAN_BUILD) -j $(JOBS) --target unit_tests && echo "unit-asan: $(ASAN_BUILD) built in $$SECONDS s"
+	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) ctest --output-on-failure -j $(CTEST_JOBS) -L unit 2>&1 | tee ctest.log && \
+	  echo "unit-asan: ctest took $$SECONDS s"
 
 fuzz-build: deps
 	CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_BUILD) $(call generator,$(FUZZ_BUILD)) -DRSG_FUZZ=ON $(OPT_FLAGS) $(CMAKE_COMMON)
-	cmake --build $(FUZZ_BUILD) -j $(JOBS)
+	cmake --build $(FUZZ_BUILD) -j $(JOBS) && echo "fuzz-build: $(FUZZ_BUILD) built in $$SECONDS s"
 
 # Each fuzzer for FUZZ_SECONDS, JOBS at a time (make fuzz FUZZ_SECONDS=600 for a long run).
 fuzz: fuzz-build
@@ -112,7 +113,8 @@ fuzz: fuzz-build
 # What a contributor runs: every ctest test but those labelled long or jazzy, side by side; the unit tests
 # again under ASan+UBSan; every fuzzer for TEST_FUZZ_SECONDS (docs/development.md has the time each part takes).
 test: build-tests
-	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -LE 'long|jazzy' 2>&1 | tee ctest.log
+	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -LE 'long|jazzy' 2>&1 | tee ctest.log && \
+	  echo "make test: ctest took $$SECONDS s"
 	$(MAKE) unit-asan
 	$(MAKE) fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS)
 	@tests/summarize.sh $(BUILD)/ctest.log $(ASAN_BUILD)/ctest.log -- $(FUZZ_BUILD)/fuzz.log

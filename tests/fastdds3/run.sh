@@ -58,9 +58,11 @@ echo "test-fastdds3: built in the chroot in $((SECONDS - start)) s"
 # Not here: IngressAllocation.* (Fast DDS 3.1.2 allocates inside DataWriter::write(), the zero-allocation
 # claim is 2.9's: docs/fastdds-versions.md) and packaging (it checks Debian 12's package lists);
 # packaging.install_consumer runs with the process tests below.
-$chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -L unit -E '^(IngressAllocation\..*|packaging)\$'" 2>&1 | tee "$logs/unit.log" | tail -n 3
+# Side by side, one more than the cores, as make test: each test that opens DDS holds a domain of its
+# own (tests/support/test_domain.py), and the RUN_SERIAL ones still run alone.
+$chroot in sh -c "cd $build && ctest --output-on-failure -j $((jobs + 1)) -L unit -E '^(IngressAllocation\..*|packaging)\$'" 2>&1 | tee "$logs/unit.log" | tail -n 3
 count_ctest "$logs/unit.log"
-$chroot in sh -c "cd $build && ctest --output-on-failure -j 1 -R '^($processes)\$'" \
+$chroot in sh -c "cd $build && ctest --output-on-failure -j $((jobs + 1)) -R '^($processes)\$'" \
   2>&1 | tee "$logs/processes.log" | grep -E '^ *[0-9]+/[0-9]+ Test|tests passed'
 count_ctest "$logs/processes.log"
 
