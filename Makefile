@@ -39,7 +39,7 @@ SHELL      := /bin/bash
 .SHELLFLAGS := -o pipefail -c
 
 
-.PHONY: all deps deps-run build build-tests build-demo install test test-long test-jazzy unit-asan fuzz fuzz-build demo bench format clean wireshark-plugin
+.PHONY: all deps deps-test deps-run build build-tests build-demo install test test-long test-jazzy unit-asan fuzz fuzz-build demo bench format clean wireshark-plugin
 
 all: build
 
@@ -59,8 +59,9 @@ endef
 deps-run:
 	$(call apt_install,build run)
 
-# Everything make test needs: Debian packages, npm packages, the Python environments and Go tools.
-deps: deps-run
+# Everything make test needs: Debian packages, npm packages, the Python environments (ROS 2 Kilted's
+# among them) and Go tools.
+deps-test: deps-run
 	$(call apt_install,test package)
 	@# Node and npm for the tests that read MCAP files with @mcap/core (Debian's, unless a node is there).
 	@command -v npm >/dev/null || { $(SUDO) apt-get update -qq && \
@@ -69,7 +70,12 @@ deps: deps-run
 	  npm ci --prefix tests/tools/record --no-audit --no-fund
 	@[ tests/tools/view/package-lock.json -ot tests/tools/view/node_modules/.package-lock.json ] || \
 	  npm ci --prefix tests/tools/view --no-audit --no-fund
-	@for script in tools/deps/*.sh; do DEPS_DIR=$(DEPS_DIR) $$script || exit 1; done
+	@for script in tools/deps/*.sh; do DEPS_DIR=$(DEPS_DIR) RSG_ROS_DISTROS=kilted $$script || exit 1; done
+
+# Everything every suite needs: deps-test and ROS 2 Jazzy's environment (make test-jazzy,
+# test-fastdds214, test-image, test-service, bench), which make test leaves out (its time budget).
+deps: deps-test
+	@for script in tools/deps/*.sh; do DEPS_DIR=$(DEPS_DIR) RSG_ROS_DISTROS="kilted jazzy" $$script || exit 1; done
 
 # The tests' build and the demo's are one tree with one set of flags: -O2 with line tables only
 # (-g1: file:line in every stack and sanitizer report, at about a third less compiling than full
@@ -85,7 +91,7 @@ build: deps-run
 	cmake --build $(BUILD) -j $(JOBS)
 
 # The product and every test and benchmark, with everything the tests need (make deps).
-build-tests: deps
+build-tests: deps-test
 	cmake -S . -B $(BUILD) $(call generator,$(BUILD)) $(OPT_FLAGS) -DRSG_BUILD_TESTS=ON $(CMAKE_COMMON)
 	cmake --build $(BUILD) -j $(JOBS) && echo "build-tests: $(BUILD) built in $$SECONDS s"
 
@@ -95,14 +101,14 @@ install: build
 	cmake --install $(BUILD) $(if $(PREFIX),--prefix $(PREFIX))
 
 # Unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer.
-unit-asan: deps
+unit-asan: deps-test
 	cmake -S . -B $(ASAN_BUILD) $(call generator,$(ASAN_BUILD)) -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-g1 -DCMAKE_C_FLAGS_DEBUG=-g1 \
 	      -DRSG_SANITIZE=ON $(CMAKE_COMMON)
 	cmake --build $(ASAN_BUILD) -j $(JOBS) --target unit_tests && echo "unit-asan: $(ASAN_BUILD) built in $$SECONDS s"
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) ctest --output-on-failure -j $(CTEST_JOBS) -L unit 2>&1 | tee ctest.log && \
 	  echo "unit-asan: ctest took $$SECONDS s"
 
-fuzz-build: deps
+fuzz-build: deps-test
 	CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_BUILD) $(call generator,$(FUZZ_BUILD)) -DRSG_FUZZ=ON $(OPT_FLAGS) $(CMAKE_COMMON)
 	cmake --build $(FUZZ_BUILD) -j $(JOBS) && echo "fuzz-build: $(FUZZ_BUILD) built in $$SECONDS s"
 
@@ -128,7 +134,7 @@ test-long: build-tests
 # The rclpy tests again with ROS 2 Jazzy nodes (ctest label jazzy, tests/ros2/CMakeLists.txt: rclpy
 # 7.1 on Fast DDS 2.14 from make deps' .deps/ros2-jazzy against the gateway); make test runs them
 # with Kilted's. A part of its own in .ci/run: together they would exceed make test's time budget.
-test-jazzy: build-tests
+test-jazzy: deps build-tests
 	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -L jazzy 2>&1 | tee ctest-jazzy.log
 	@tests/summarize.sh $(BUILD)/ctest-jazzy.log --
 
@@ -149,7 +155,7 @@ demo: build-demo
 	@echo "make demo: now building $(USER_TARGETS) into $(BUILD)/bin (record and replay: docs/record-replay.md)"
 	cmake --build $(BUILD) -j $(JOBS) --target $(USER_TARGETS)
 
-bench: build-tests
+bench: deps build-tests
 	tests/bench/run_bench.sh $(BUILD)
 
 # The SEND_BUF dissector into Wireshark's personal Lua plugins folder (where `tshark -G folders` says).
@@ -161,7 +167,7 @@ wireshark-plugin:
 
 # Where the time of a fresh build and of ctest goes (docs/development.md): its own tree, no ccache.
 .PHONY: time-report
-time-report: deps
+time-report: deps-test
 	tools/time_report.py --build build-time
 
 format:
@@ -180,7 +186,7 @@ test-fastdds3: build-tests
 # CMAKE_PREFIX_PATH, and across versions with $(BUILD)'s 2.9.1 (tests/fastdds214/run.sh,
 # docs/fastdds-versions.md). Its own tree, build-fdds214/.
 .PHONY: test-fastdds214
-test-fastdds214: build-tests
+test-fastdds214: deps build-tests
 	JOBS=$(JOBS) DEPS_DIR=$(DEPS_DIR) tests/fastdds214/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds214.log
 
 # make bench's e2e suite on 2.9 (host) and 3.x (chroot) back to back, side by side (docs/benchmarks/fastdds3/).

@@ -62,5 +62,7 @@ build_workspace() {
   )
 }
 
-build_workspace "$deps_dir/ros2" "$deps_dir/ros2_ws" tools/deps/python/ros2.txt
-build_workspace "$deps_dir/ros2-jazzy" "$deps_dir/ros2_ws-jazzy" tools/deps/python/ros2-jazzy.txt
+# RSG_ROS_DISTROS as in python.sh.
+distros=" ${RSG_ROS_DISTROS:-kilted jazzy} "
+[[ $distros != *" kilted "* ]] || build_workspace "$deps_dir/ros2" "$deps_dir/ros2_ws" tools/deps/python/ros2.txt
+[[ $distros != *" jazzy "* ]] || build_workspace "$deps_dir/ros2-jazzy" "$deps_dir/ros2_ws-jazzy" tools/deps/python/ros2-jazzy.txt
