@@ -511,9 +511,67 @@ def retention(h):
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
 
 
+def trigger(h):
+    """--trigger: nothing is written before an event. SIGUSR1 writes the --pre seconds before it and
+    the --post seconds after it to FILE_0.mcap, the frames exact and in order; the gateway's link going
+    down is an event too (every flap of a loaded host's stream as well), the last file ending with the
+    last frame; --trigger-buffer bounds the --pre window in memory (the file then starts later, with a
+    warning)."""
+    port, gateway, stats, rec, out = gateway_with_recorder(h, "--trigger", "signal", "--pre", "1", "--post", "1")
+    down = recorder(h, "record_down", h.dir / "down.mcap", "--trigger", "link-down", "--pre", "1", "--post", "0.5")
+    small = recorder(h, "record_small", h.dir / "small.mcap", "--trigger", "signal", "--pre", "5", "--post", "1",
+                     "--trigger-buffer", "0.5", "--status-topic", "")
+    wait_matched(h, stats, ["record", "record_down", "record_small"], "rsg_record")
+    count, record = 4000, h.dir / "sim.record.jsonl"
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", str(count),
+                          "--record", str(record)])
+    wait_for_stats(stats, lambda s: s["frames_published"] >= 2000, "2 s of the stream")
+    early = list(h.dir.glob("run_*.mcap")) + list(h.dir.glob("small_*.mcap"))
+    check(not early, f"a triggered recorder wrote before its event: {early}")
+    rec.send_signal(signal.SIGUSR1)
+    small.send_signal(signal.SIGUSR1)
+    wait_for(lambda: all("event 0 recorded" in stderr_of(h, label) for label in ("record", "record_small")),
+             "the files of the SIGUSR1 events", timeout_s=20)
+    check(h.wait("sim", sim, 30) == 0, "rsg_sim failed")
+    wait_for_stats(stats, lambda s: not s["link_up"], "the gateway to see the link down")
+    time.sleep(0.5)  # its status sample reaches the recorder
+
+    def events_recorded():
+        err = stderr_of(h, "record_down")
+        return err.count(", writing ") == err.count(" recorded: ") > 0
+    wait_for(events_recorded, "the file of the link-down event", timeout_s=20)
+    for label, process in (("record", rec), ("record_down", down), ("record_small", small)):
+        check(h.stop(label, process) == 0, f"{label} did not exit 0: {stderr_of(h, label)}")
+    files = sorted(path.name for path in h.dir.glob("*.mcap") if not path.name.startswith("down_"))
+    check(files == ["run_0.mcap", "small_0.mcap"], f"the SIGUSR1 events wrote {files}")
+    check("; 1 event (1 trigger)" in stderr_of(h, "record"), stderr_of(h, "record"))
+
+    def exact(path):
+        seen = node_check(h, path)
+        check(seen["states"] > 0 and seen["sequence_breaks"] == 0, f"{path.name}: {seen}")
+        node_check(h, path, "--frames", record, "--skip", seen["first_sequence"] - 1)
+        return seen
+
+    signalled = exact(h.dir / "run_0.mcap")
+    check(1500 <= signalled["states"] <= 2500 and signalled["statuses"] >= 1,
+          f"--pre 1 --post 1 of a 1 kHz stream: {signalled}")
+    downs = sorted(h.dir.glob("down_*.mcap"), key=lambda path: int(path.stem.split("_")[1]))
+    last = exact(downs[-1])
+    check(last["first_sequence"] - 1 + last["states"] == count and last["statuses"] >= 1,
+          f"the link-down event's file of a stream that stopped at frame {count}: {last}")
+    check("the link went down: event 0" in stderr_of(h, "record_down"), stderr_of(h, "record_down"))
+    # Unbounded, 2 s before the event and 1 s after; 0.5 MB holds well under a second of full frames
+    # (the last 0.5 s before the event wait in the publication-order hold, not in the window).
+    bounded = exact(h.dir / "small_0.mcap")
+    err = stderr_of(h, "record_small")
+    check(bounded["states"] < 2500 and "--trigger-buffer 0.5 MB holds" in err
+          and "samples of the --pre window left out (--trigger-buffer)" in err, f"{bounded}: {err}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
 CASES = {f.__name__: f for f in (reference_reader, sigkill, write_errors, replay_roundtrip, split_and_view, duration,
                                  ros2_profile, chunk_size_fsync, drain_on_sigterm, mid_stream_under_load, no_writer,
-                                 retention)}
+                                 retention, trigger)}
 
 if __name__ == "__main__":
     sys.exit(main(f"record_{CASE}", CASES[CASE]))
