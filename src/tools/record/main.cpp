@@ -1,7 +1,8 @@
 // rsg_record: subscribes to RobotState (whole or through a view) and GatewayStatus, and writes
 // every sample to an MCAP file as the CDR bytes a DDS writer sends, with the schema to decode them.
 //
-// With --trigger it records only around events (SIGUSR1, the gateway's link going down): the last
+// With --trigger it records only around events (SIGUSR1, the gateway's link going down, invalid
+// frames): the last
 // --pre seconds of samples wait in memory, bounded by --trigger-buffer, and an event writes them and
 // the --post seconds after it to a file of their own.
 //
@@ -37,6 +38,7 @@
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
+#include "status/status_sample.hpp"
 
 namespace {
 
@@ -149,6 +151,14 @@ class Recording {
     if (options_.trigger_on("link-down")) {
       if (link_up_.value_or(false) && !sample.link_up()) trigger(log_time_of(info), "the link went down");
       link_up_ = sample.link_up();
+    }
+    // --trigger invalid: the gateway counted invalid frames since its previous status sample (the
+    // counters are totals: the first sample only sets the baseline).
+    if (options_.trigger_on("invalid")) {
+      const std::uint64_t invalid = rsg::status::from_status_sample(sample).ingress.invalid_total();
+      if (invalid_ && invalid > *invalid_)
+        trigger(log_time_of(info), fmt::format("{} invalid frames", invalid - *invalid_));
+      invalid_ = invalid;
     }
   }
 
@@ -406,8 +416,9 @@ class Recording {
   std::deque<rsg::app::PublicationOrder::Sample> pre_;  // --trigger: the --pre window, oldest first
   std::uint64_t pre_bytes_ = 0;
   bool warned_buffer_ = false;
-  std::uint64_t event_end_ = 0;  // --trigger: the log time up to which the current event records
-  std::optional<bool> link_up_;  // --trigger link-down: as the last status sample said
+  std::uint64_t event_end_ = 0;           // --trigger: the log time up to which the current event records
+  std::optional<bool> link_up_;           // --trigger link-down: as the last status sample said
+  std::optional<std::uint64_t> invalid_;  // --trigger invalid: the last status sample's total
 };
 
 void add_options(CLI::App& app, Options& options) {
@@ -433,9 +444,10 @@ void add_options(CLI::App& app, Options& options) {
   auto* trigger =
       app.add_option("--trigger", options.triggers,
                      "Record only around events: signal (SIGUSR1), link-down (the gateway's status says "
-                     "its link went down); each event gets a file FILE_0.mcap, FILE_1.mcap, ... with --pre "
+                     "its link went down), invalid (it counted invalid frames since its previous status); "
+                     "each event gets a file FILE_0.mcap, FILE_1.mcap, ... with --pre "
                      "seconds before it and --post after (an event meanwhile extends it)")
-          ->check(CLI::IsMember({"signal", "link-down"}))
+          ->check(CLI::IsMember({"signal", "link-down", "invalid"}))
           ->delimiter(',')
           ->excludes(split);
   app.add_option("--pre", options.pre_s, "With --trigger: seconds recorded before an event")
@@ -639,9 +651,10 @@ int main(int argc, char** argv) {
                                         options.max_files != 0 ? "--max-files"
                                         : options.max_mb > 0   ? "--max-size"
                                                                : "--max-age"));
-    if (options.trigger_on("link-down") && options.status_topic.empty())
-      throw rsg::InputError(
-          "--trigger link-down reads the gateway's status: --status-topic must not be empty");
+    for (const char* status_trigger : {"link-down", "invalid"})
+      if (options.trigger_on(status_trigger) && options.status_topic.empty())
+        throw rsg::InputError(fmt::format(
+            "--trigger {} reads the gateway's status: --status-topic must not be empty", status_trigger));
     // Before DDS starts its threads (StopOnSignal::block_stop_signals() says why).
     if (options.trigger_on("signal")) TriggerSignal::block();
     if (options.max_mb > 0 && options.max_mb < 2 * options.split_mb)

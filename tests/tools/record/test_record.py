@@ -515,23 +515,31 @@ def trigger(h):
     """--trigger: nothing is written before an event. SIGUSR1 writes the --pre seconds before it and
     the --post seconds after it to FILE_0.mcap, the frames exact and in order; the gateway's link going
     down is an event too (every flap of a loaded host's stream as well), the last file ending with the
-    last frame; --trigger-buffer bounds the --pre window in memory (the file then starts later, with a
+    last frame, and so are invalid frames the gateway counted (here from rsg_flood, beside the
+    stream); --trigger-buffer bounds the --pre window in memory (the file then starts later, with a
     warning)."""
     port, gateway, stats, rec, out = gateway_with_recorder(h, "--trigger", "signal", "--pre", "1", "--post", "1")
     down = recorder(h, "record_down", h.dir / "down.mcap", "--trigger", "link-down", "--pre", "1", "--post", "0.5")
     small = recorder(h, "record_small", h.dir / "small.mcap", "--trigger", "signal", "--pre", "5", "--post", "1",
                      "--trigger-buffer", "0.5", "--status-topic", "")
-    wait_matched(h, stats, ["record", "record_down", "record_small"], "rsg_record")
+    # The gateway's status, once a second, says what it counted: the event comes up to a second after
+    # the invalid frames, so --pre covers that second too.
+    invalid = recorder(h, "record_invalid", h.dir / "invalid.mcap", "--trigger", "invalid", "--pre", "2", "--post",
+                       "0.5")
+    wait_matched(h, stats, ["record", "record_down", "record_small", "record_invalid"], "rsg_record")
     count, record = 4000, h.dir / "sim.record.jsonl"
     sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", str(count),
                           "--record", str(record)])
     wait_for_stats(stats, lambda s: s["frames_published"] >= 2000, "2 s of the stream")
-    early = list(h.dir.glob("run_*.mcap")) + list(h.dir.glob("small_*.mcap"))
+    early = [path for name in ("run", "small", "invalid") for path in h.dir.glob(f"{name}_*.mcap")]
     check(not early, f"a triggered recorder wrote before its event: {early}")
     rec.send_signal(signal.SIGUSR1)
     small.send_signal(signal.SIGUSR1)
-    wait_for(lambda: all("event 0 recorded" in stderr_of(h, label) for label in ("record", "record_small")),
-             "the files of the SIGUSR1 events", timeout_s=20)
+    check(h.run("flood", [h.binary("rsg_flood"), "--to", f"127.0.0.1:{port}", "--count", "5", "--sizes", "10"]) == 0,
+          "rsg_flood failed")
+    wait_for(lambda: all("event 0 recorded" in stderr_of(h, label) for label in ("record", "record_small",
+                                                                                "record_invalid")),
+             "the files of the SIGUSR1 and invalid-frame events", timeout_s=20)
     check(h.wait("sim", sim, 30) == 0, "rsg_sim failed")
     wait_for_stats(stats, lambda s: not s["link_up"], "the gateway to see the link down")
     time.sleep(0.5)  # its status sample reaches the recorder
@@ -540,10 +548,11 @@ def trigger(h):
         err = stderr_of(h, "record_down")
         return err.count(", writing ") == err.count(" recorded: ") > 0
     wait_for(events_recorded, "the file of the link-down event", timeout_s=20)
-    for label, process in (("record", rec), ("record_down", down), ("record_small", small)):
+    for label, process in (("record", rec), ("record_down", down), ("record_small", small),
+                           ("record_invalid", invalid)):
         check(h.stop(label, process) == 0, f"{label} did not exit 0: {stderr_of(h, label)}")
     files = sorted(path.name for path in h.dir.glob("*.mcap") if not path.name.startswith("down_"))
-    check(files == ["run_0.mcap", "small_0.mcap"], f"the SIGUSR1 events wrote {files}")
+    check(files == ["invalid_0.mcap", "run_0.mcap", "small_0.mcap"], f"the events wrote {files}")
     check("; 1 event (1 trigger)" in stderr_of(h, "record"), stderr_of(h, "record"))
 
     def exact(path):
@@ -560,6 +569,10 @@ def trigger(h):
     check(last["first_sequence"] - 1 + last["states"] == count and last["statuses"] >= 1,
           f"the link-down event's file of a stream that stopped at frame {count}: {last}")
     check("the link went down: event 0" in stderr_of(h, "record_down"), stderr_of(h, "record_down"))
+    flooded = exact(h.dir / "invalid_0.mcap")
+    err = stderr_of(h, "record_invalid")
+    check("invalid frames: event 0" in err and "; 1 event (" in err and flooded["statuses"] >= 1,
+          f"{flooded}: {err}")
     # Unbounded, 2 s before the event and 1 s after; 0.5 MB holds well under a second of full frames
     # (the last 0.5 s before the event wait in the publication-order hold, not in the window).
     bounded = exact(h.dir / "small_0.mcap")
