@@ -178,8 +178,6 @@ class Recording {
     open();
     for (const auto& sample : pre_)
       if (sample.log_time + pre_ns_ >= at_ns) write_to_file(sample, sample.log_time);
-    pre_.clear();
-    pre_bytes_ = 0;
   }
 
   /// Writes what is due at `now` in publication order. A sample placed after one received later is
@@ -354,10 +352,9 @@ class Recording {
     if (sample.channel == channels_.robot_state) ++states_written;
     if (options_.triggered()) {
       if (writer_ && log_time > event_end_) finish_event();
-      if (writer_)
-        write_to_file(sample, log_time);
-      else
-        keep_for_an_event(sample, log_time);
+      if (writer_) write_to_file(sample, log_time);
+      // Kept during an event too: an event soon after this one gets its whole --pre window as well.
+      keep_for_an_event(sample, log_time);
       return;
     }
     // After a split the next file is opened by the next message, so that none is left empty.
