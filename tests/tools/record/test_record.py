@@ -547,7 +547,9 @@ def trigger(h):
     wait_for(lambda: "event 1 recorded" in stderr_of(h, "record"), "the file of the second SIGUSR1", timeout_s=20)
     check(h.wait("sim", sim, 30) == 0, "rsg_sim failed")
     wait_for_stats(stats, lambda s: not s["link_up"], "the gateway to see the link down")
-    time.sleep(0.5)  # its status sample reaches the recorder
+    # Its status sample reaches the recorder, whose event ends --post (0.5 s) and the order's hold
+    # (0.5 s) after it: by then every event it started is recorded.
+    time.sleep(1.5)
 
     def events_recorded():
         err = stderr_of(h, "record_down")
