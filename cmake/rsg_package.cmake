@@ -13,7 +13,7 @@
 
 # Debian's man pages: help2man on each tool's --help at build time (cmake/rsg_man_page.cmake), so
 # that a page cannot say what the tool does not. `make package` builds the rsg_man target.
-set(RSG_TOOLS rsg_gateway rsg_sim rsg_echo rsg_frame rsg_record rsg_replay rsg_view)
+# RSG_TOOLS: the installed tools (CMakeLists.txt).
 set(RSG_PROFILES_INSTALLED ${CMAKE_INSTALL_FULL_DATADIR}/rsg/xml_profiles)
 find_program(HELP2MAN help2man)
 set(man_pages)

@@ -83,7 +83,7 @@ gbench_options() {
 
 run_wire() {
   # shellcheck disable=SC2046  # word splitting of the options is intended
-  "$build/bin/rsg_bench_wire" $(gbench_options wire)
+  "$build/tests/bin/rsg_bench_wire" $(gbench_options wire)
 }
 report_wire() { python3 "$here/bench_table.py" "$out/wire.json"; }
 
@@ -97,7 +97,7 @@ E2E_LATENCY_SCENARIOS=(baseline_udp_oneway embedded_callback baseline_fastdds ga
                        cyclone_ddsperf)
 
 run_e2e() {
-  local bench=$build/bin/rsg_bench_e2e runs=$out/e2e
+  local bench=$build/tests/bin/rsg_bench_e2e runs=$out/e2e
   local seconds=30 step_seconds=10 soak_seconds=300 soak_concurrent=true
   if [[ ${RSG_BENCH_FULL:-0} == 1 ]]; then
     seconds=120 step_seconds=30 soak_concurrent=false
@@ -162,7 +162,8 @@ PY
 run_scale() {
   local where=(--receive-off-sender)
   [[ ${RSG_BENCH_SCALE_SENDER_PAYS:-0} == 1 ]] && where=()
-  python3 "$here/scale.py" --bin "$build/bin" --out "$out/scale" --seconds "${RSG_BENCH_SCALE_SECONDS:-8}" \
+  python3 "$here/scale.py" --bin "$build/bin" --test-bin "$build/tests/bin" --out "$out/scale" \
+    --seconds "${RSG_BENCH_SCALE_SECONDS:-8}" \
     --series "${RSG_BENCH_SCALE_SERIES:-robots,readers}" --discovery-server "${where[@]}" >/dev/null
 }
 report_scale() { cat "$out/scale/scale.md"; }
@@ -173,7 +174,7 @@ run_late_join() {
 report_late_join() { cat "$out/late_join/late_join.md"; }
 
 run_readers() {
-  python3 "$here/readers/readers.py" --bin "$build/bin" --out "$out/readers" \
+  python3 "$here/readers/readers.py" --bin "$build/bin" --test-bin "$build/tests/bin" --out "$out/readers" \
     --seconds "${RSG_BENCH_READERS_SECONDS:-8}" > "$out/readers.txt"
 }
 report_readers() { sed -n '/^###/,$p' "$out/readers.txt"; }

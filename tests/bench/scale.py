@@ -126,10 +126,11 @@ class Point:
 
     def measure(self):
         b = Path(self.args.bin)
+        t = Path(self.args.test_bin) if self.args.test_bin else b.parent / "tests" / "bin"
         if self.args.discovery_server:
             self.start("gw", "ds", discovery_server_argv(DS_PORT))
         for k in range(self.robots):  # the robots stream before there is a gateway, as on a plant restart
-            self.start("robot", f"robot{k}", [b / "rsg_bench_scale_probe", "send", "--to",
+            self.start("robot", f"robot{k}", [t / "rsg_bench_scale_probe", "send", "--to",
                                               f"{HOSTS['gw']}:{RAW_PORT + k}", "--rate", 1000,
                                               "--duration", self.args.seconds + 60])
         launched = time.monotonic()
@@ -163,7 +164,7 @@ class Point:
             for r in range(self.readers):
                 arrivals.append(self.dir / f"arrivals{k}_{r}.txt")
                 self.start("ops1" if r % 2 == 0 else "ops2", f"reader{k}_{r}",
-                           [b / "rsg_bench_scale_probe", "read", "--domain", self.domain, "--partition",
+                           [t / "rsg_bench_scale_probe", "read", "--domain", self.domain, "--partition",
                             f"robot{k}", "--out", arrivals[-1], "--capacity", capacity,
                             "--participant-profile", self.participant_profile, *self.discovery])
         time.sleep(self.args.warmup)
@@ -370,6 +371,8 @@ def free(rows):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--bin", required=True)
+    parser.add_argument("--test-bin", help="directory of the bench's helpers (default: BIN/../tests/bin, the build "
+                                           "tree's: CONTRIBUTING.md, \"Build tree\")")
     parser.add_argument("--out", required=True)
     parser.add_argument("--seconds", type=float, default=8.0)
     parser.add_argument("--warmup", type=float, default=2.0)

@@ -88,19 +88,24 @@ count_ctest "$logs/processes.log"
 check ros2_node_jazzy python3 tests/ros2/test_ros2_node.py --bin "$build/bin"
 
 # 4. Against 2.9.
-if [[ ! -x $host_build/bin/rsg_type_dump || ! -x $host_build/bin/rsg_views_publish ]]; then
+if [[ ! -x $host_build/tests/bin/rsg_type_dump || ! -x $host_build/tests/bin/rsg_views_publish ]]; then
   echo "test-fastdds214: no host build in $host_build (make build): 2.9 <-> 2.14 not run" >&2
   failed=$((failed + 1))
 else
   # The type support: the same bytes for the same sample, the same largest sizes, the same type
   # identifiers (TypeInformation) as fastddsgen 2.3's on 2.9.
-  check type_support_matches_2.9 diff <("$host_build/bin/rsg_type_dump") <("$build/bin/rsg_type_dump")
-  # Bin directories with each tool from one version: the 2.9 build's, some replaced by 2.14's.
+  check type_support_matches_2.9 diff <("$host_build/tests/bin/rsg_type_dump") <("$build/tests/bin/rsg_type_dump")
+  # Bin directories with each executable from one version: the 2.9 build's (bin/ and tests/bin/:
+  # CONTRIBUTING.md, "Build tree"), some replaced by 2.14's.
   mixed() {  # NAME TOOLS_FROM_2.14...
-    local dir=$logs/bin-$1 tool; shift
+    local dir=$logs/bin-$1 tool path; shift
     rm -rf "$dir" && mkdir -p "$dir"
-    for tool in "$checkout/$host_build"/bin/*; do ln -s "$tool" "$dir/"; done
-    for tool in "$@"; do ln -sfn "$checkout/$build/bin/$tool" "$dir/$tool"; done
+    for tool in "$checkout/$host_build"/bin/* "$checkout/$host_build"/tests/bin/*; do ln -s "$tool" "$dir/"; done
+    for tool in "$@"; do
+      path=$checkout/$build/bin/$tool
+      [[ -e $path ]] || path=$checkout/$build/tests/bin/$tool
+      ln -sfn "$path" "$dir/$tool"
+    done
     echo "$dir"
   }
   gateway214=$(mixed gateway214 rsg_gateway)
@@ -109,7 +114,7 @@ else
   # Views, content filters included: 2.14 readers on a 2.9 writer's stream, and 2.9 readers on 2.14's.
   check views_2.9_writer_2.14_readers env RSG_SIM="$host_build/bin/rsg_sim" RSG_GATEWAY="$host_build/bin/rsg_gateway" \
     python3 tests/dds/echo_views_test.py --echo "$echo214/rsg_echo" \
-    --publish "$host_build/bin/rsg_views_publish" -v
+    --publish "$host_build/tests/bin/rsg_views_publish" -v
   check views_2.14_writer_2.9_readers env RSG_SIM="$host_build/bin/rsg_sim" RSG_GATEWAY="$host_build/bin/rsg_gateway" \
     python3 tests/dds/echo_views_test.py --echo "$host_build/bin/rsg_echo" \
     --publish "$publish214/rsg_views_publish" -v

@@ -32,7 +32,7 @@ cmake --build "$host_build" -j "${JOBS:-$(nproc)}" --target "${targets[@]}" rsg_
 # The host's tools with a 3.x gateway: a script that runs the chroot's build (readers.py counts its
 # process tree).
 gateway3=$PWD/$build/bench/bin-gateway3
-$chroot mixed "$gateway3" "$PWD/$host_build/bin" "$PWD/$build/bin" rsg_gateway
+$chroot mixed "$gateway3" "$PWD/$host_build" "$PWD/$build" rsg_gateway
 if [[ " ${suites[*]} " == *" readers "* ]]; then
   python3 tests/bench/readers/readers.py --bin "$host_build/bin" --label fastdds2.9 --out "$build/bench/readers"
   python3 tests/bench/readers/readers.py --bin "$host_build/bin" --gateway "$gateway3/rsg_gateway" \

@@ -67,14 +67,14 @@ $chroot in sh -c "cd $build && ctest --output-on-failure -j $((jobs + 1)) -R '^(
 count_ctest "$logs/processes.log"
 
 # 3. Across versions: Fast DDS 2.9.1 processes on the host, 3.1.2 processes in the chroot.
-if [[ ! -x $host_build/bin/rsg_echo || ! -x $host_build/bin/rsg_views_publish ]]; then
+if [[ ! -x $host_build/bin/rsg_echo || ! -x $host_build/tests/bin/rsg_views_publish ]]; then
   echo "test-fastdds3: no host build in $host_build (make build): cross-version tests not run" >&2
   failed=$((failed + 1))
 else
   # Bin directories with each tool from one version: a 3.x tool is a script running it in the chroot.
   mixed() {  # NAME TOOLS_FROM_3X...
     local dir=$logs/bin-$1; shift
-    $chroot mixed "$dir" "$checkout/$host_build/bin" "$checkout/$build/bin" "$@"
+    $chroot mixed "$dir" "$checkout/$host_build" "$checkout/$build" "$@"
     echo "$dir"
   }
   gateway3=$(mixed gateway3 rsg_gateway)
@@ -84,7 +84,7 @@ else
   # Views, content filters included: 3.x readers on a 2.9 writer's stream, and 2.9 readers on 3.x's.
   check views_2.9_writer_3_readers env RSG_SIM="$host_build/bin/rsg_sim" RSG_GATEWAY="$host_build/bin/rsg_gateway" \
     python3 tests/dds/echo_views_test.py --echo "$echo3/rsg_echo" \
-    --publish "$host_build/bin/rsg_views_publish" -v
+    --publish "$host_build/tests/bin/rsg_views_publish" -v
   check views_3_writer_2.9_readers env RSG_SIM="$host_build/bin/rsg_sim" RSG_GATEWAY="$host_build/bin/rsg_gateway" \
     python3 tests/dds/echo_views_test.py --echo "$host_build/bin/rsg_echo" \
     --publish "$publish3/rsg_views_publish" -v
@@ -93,9 +93,9 @@ else
   check sim_to_echo_2.9_gateway_3_echo python3 tests/integration/test_sim_to_echo.py --bin "$echo3"
   # ROS 2 types from ROS's own tools (rosidl -> IDL -> Cyclone, built on the host) and a 3.1.2 gateway:
   # its --ros2 topics read, a view on them (rsg_echo --ros2 --view, 3.1.2), egress from a ROS publisher.
-  if [[ -x $host_build/bin/rsg_ros2_cyclone_echo ]]; then
+  if [[ -x $host_build/tests/bin/rsg_ros2_cyclone_echo ]]; then
     for test in gateway egress; do
-      check ros2_rosidl_cyclone_${test}_3 env RSG_ROS2_ECHO="$checkout/$host_build/bin/rsg_ros2_cyclone_echo" \
+      check ros2_rosidl_cyclone_${test}_3 env RSG_ROS2_ECHO="$checkout/$host_build/tests/bin/rsg_ros2_cyclone_echo" \
         python3 tests/ros2/test_ros2_$test.py --bin "$gateway_echo3"
     done
   else

@@ -24,7 +24,7 @@ jobs=${FUZZ_JOBS:-$(nproc)}
 # One fuzzer; its report goes to logs/<name>.report, its summary row to logs/<name>.row.
 fuzz_one() {
   local name=$1 seed_dirs=$2
-  local binary=$build/bin/$name log=$work/logs/$name.log corpus=$work/corpus/$name
+  local binary=$build/tests/bin/$name log=$work/logs/$name.log corpus=$work/corpus/$name
   local seeds=() status=0 dir last runs cov ft corp
   mkdir -p "$corpus"
   for dir in $seed_dirs; do [[ -d $dir ]] && seeds+=("$dir"); done

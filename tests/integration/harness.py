@@ -109,19 +109,24 @@ class Harness:
     def __init__(self, name):
         parser = argparse.ArgumentParser()
         parser.add_argument("--bin", required=True, help="directory of rsg_gateway, rsg_sim, rsg_echo")
+        # The build tree keeps the tools in bin/ and every other executable in tests/bin/
+        # (CONTRIBUTING.md, "Build tree"): ctest gives both; by hand --bin build/bin is enough.
+        parser.add_argument("--test-bin", help="directory of the test helpers (default: tests/bin beside --bin)")
         self.args = parser.parse_args()
         self.bin = Path(self.args.bin)
+        self.test_bin = Path(self.args.test_bin) if self.args.test_bin else self.bin.parent / "tests" / "bin"
         self.name = name
         self.dir = Path(tempfile.mkdtemp(prefix=f"rsg_{name}_"))
         self.domain = test_domain()
         self.children = []
 
     def binary(self, name):
-        """The path of an executable of --bin; a test fails (never skips) when it is not built."""
-        path = self.bin / name
-        if not path.exists():
-            raise TestFailure(f"{path} is not built: cmake --build build --target {name}")
-        return str(path)
+        """The path of an executable of --bin, else of --test-bin (a directory of wrappers, as
+        test-fastdds3's, holds both kinds in --bin); a test fails (never skips) when it is not built."""
+        for directory in (self.bin, self.test_bin):
+            if (directory / name).exists():
+                return str(directory / name)
+        raise TestFailure(f"{name} is in neither {self.bin} nor {self.test_bin}: cmake --build build --target {name}")
 
     def start(self, label, argv, stdin=None):
         """Starts a child with stdout and stderr in files of the scratch directory."""

@@ -8,7 +8,7 @@ failure of something that must happen, never a pass: "X never happens" is checke
 permitted reader, started after X's would-be culprit, has received everything.
 
 Run by ctest (label `integration`), one test per entry; by hand, as root for the capture tests:
-    tests/security/security_test.py --probe build-sec/bin/rsg_secure_probe \\
+    tests/security/security_test.py --probe build-sec/tests/bin/rsg_secure_probe \\
         --make-pki xml_profiles/security/make_test_pki.sh \\
         --plain-profiles tests/security/plain_udp_profiles.xml --work-dir /tmp/rsg-security \\
         [-v] [Security.test_NAME ...]

@@ -6,7 +6,9 @@ a missing required one); an input file that does not exist is 2 too
 (rsg::InputError), and nothing is started.
 
 Run by ctest as tools.exit_statuses (label `cli`); by hand:
-    tests/tools/test_exit_statuses.py build/bin src
+    tests/tools/test_exit_statuses.py build/bin src [build/tests/bin]
+(the tools are in build/bin; rsg_wireshark_lua, which is not installed, is in build/tests/bin:
+CONTRIBUTING.md, "Build tree").
 The list below must name every add_executable() under src/: a new executable fails this test until
 it is added.
 Standard library only.
@@ -46,6 +48,12 @@ def run(binary, args):
     return done.returncode, done.stdout.decode(errors="replace"), done.stderr.decode(errors="replace")
 
 
+def executable(tool, *directories):
+    """The path of `tool` in the first of `directories` that has it (else in the first)."""
+    paths = [os.path.join(directory, tool) for directory in directories]
+    return next((path for path in paths if os.access(path, os.X_OK)), paths[0])
+
+
 def built_executables(source_dir):
     """The names of every add_executable() in the CMakeLists.txt files under `source_dir`."""
     names = set()
@@ -57,15 +65,16 @@ def built_executables(source_dir):
 
 
 def main():
-    if len(sys.argv) != 3:
-        sys.exit(f"usage: {sys.argv[0]} BIN_DIR SOURCE_DIR")
-    bin_dir, source_dir = sys.argv[1:]
+    if len(sys.argv) not in (3, 4):
+        sys.exit(f"usage: {sys.argv[0]} BIN_DIR SOURCE_DIR [TEST_BIN_DIR]")
+    bin_dir, source_dir = sys.argv[1:3]
+    test_bin_dir = sys.argv[3] if len(sys.argv) == 4 else os.path.join(bin_dir, "..", "tests", "bin")
     built = built_executables(source_dir)
     check(built == set(EXECUTABLES),
           f"the executables under {source_dir} are {sorted(built)}, this test covers {sorted(EXECUTABLES)}")
     with tempfile.TemporaryDirectory() as tmp:
         for tool, missing_inputs in EXECUTABLES.items():
-            binary = os.path.join(bin_dir, tool)
+            binary = executable(tool, bin_dir, test_bin_dir)
             if not os.access(binary, os.X_OK):
                 check(False, f"{binary} is not built (cmake --build build --target {tool})")
                 continue

@@ -9,7 +9,8 @@ this test until BAD_VALUES says how to get it wrong. A flag that takes no value 
 --version) has nothing to check.
 
 Run by ctest as tools.flag_errors (label `cli`); by hand:
-    tests/tools/test_flag_errors.py build/bin
+    tests/tools/test_flag_errors.py build/bin [build/tests/bin]
+(rsg_wireshark_lua, which is not installed, is in build/tests/bin: CONTRIBUTING.md, "Build tree").
 Standard library only.
 """
 
@@ -130,6 +131,10 @@ BAD_VALUES = {
         "--max-files": ["--split-size", "1", "--max-files", "1"],
         "--max-size": ["--split-size", "1", "--max-size", "0"],
         "--max-age": ["--split-size", "1", "--max-age", "0"],
+        "--trigger": ["--trigger", "always"],
+        "--pre": ["--trigger", "signal", "--pre", "-1"],
+        "--post": ["--trigger", "signal", "--post", "-1"],
+        "--trigger-buffer": ["--trigger", "signal", "--trigger-buffer", "0"],
         "--chunk-size": ["--chunk-size", "10"],
         "--fsync": ["--fsync=maybe"],
     },
@@ -247,9 +252,10 @@ def help_flags(command):
 
 
 def main():
-    if len(sys.argv) != 2:
-        sys.exit(f"usage: {sys.argv[0]} BIN_DIR")
+    if len(sys.argv) not in (2, 3):
+        sys.exit(f"usage: {sys.argv[0]} BIN_DIR [TEST_BIN_DIR]")
     bin_dir = sys.argv[1]
+    test_bin_dir = sys.argv[2] if len(sys.argv) == 3 else os.path.join(bin_dir, "..", "tests", "bin")
     cases = 0
     with tempfile.TemporaryDirectory() as tmp:
         open(os.path.join(tmp, "empty"), "wb").close()
@@ -265,7 +271,7 @@ def main():
         programs = {}
         for tool in ("rsg_gateway", "rsg_echo", "rsg_record", "rsg_replay", "rsg_sim", "rsg_view", "rsg_frame",
                      "rsg_wireshark_lua"):
-            binary = os.path.join(bin_dir, tool)
+            binary = os.path.join(test_bin_dir if tool == "rsg_wireshark_lua" else bin_dir, tool)
             if not os.access(binary, os.X_OK):
                 check(False, f"{binary} is not built")
                 continue

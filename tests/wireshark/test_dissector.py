@@ -2,7 +2,7 @@
 """The Wireshark dissector, run by Debian's tshark (a dissector host rsg did not write), against the
 conformance vectors; plus the committed .lua against its generator.
 
-    tests/wireshark/test_dissector.py --generator build/bin/rsg_wireshark_lua [-v]
+    tests/wireshark/test_dissector.py --generator build/tests/bin/rsg_wireshark_lua [-v]
 Standard library only; fails (never skips) when tshark is missing.
 """
 

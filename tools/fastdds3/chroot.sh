@@ -6,10 +6,11 @@
 #   tools/fastdds3/chroot.sh in CMD...     run CMD inside the chroot, in the same directory (the checkout
 #                                          is mounted at its own path; RSG_CHROOT_ENV="A=1 B=2" passes
 #                                          variables in)
-#   tools/fastdds3/chroot.sh mixed DIR HOST_BIN CHROOT_BIN TOOL...
-#                                          make DIR a bin directory of HOST_BIN's tools (2.9) in which
-#                                          each TOOL is a script running CHROOT_BIN's (3.x) in the chroot:
-#                                          the cross-version tests and benchmarks take it as --bin
+#   tools/fastdds3/chroot.sh mixed DIR HOST_BUILD CHROOT_BUILD TOOL...
+#                                          make DIR a bin directory of HOST_BUILD's executables (2.9:
+#                                          bin/ and tests/bin/) in which each TOOL is a script running
+#                                          CHROOT_BUILD's (3.x) in the chroot: the cross-version tests
+#                                          and benchmarks take it as --bin
 #
 # The chroot lives in the git-ignored $RSG_TRIXIE_DIR (default .deps/trixie). `run` and `in` work in
 # a private mount namespace (unshare -m): /proc, /sys, /dev, /dev/shm, /tmp (files the tests hand
@@ -124,15 +125,19 @@ exec_in_namespace() {
     __mounted "$@"
 }
 
+# A build tree keeps the installed tools in bin/ and every other executable in tests/bin/
+# (CONTRIBUTING.md, "Build tree"); DIR has both kinds.
 mixed() {
-  local dir=$1 host_bin=$2 chroot_bin=$3 tool
+  local dir=$1 host_build=$2 chroot_build=$3 tool path
   shift 3
   rm -rf "$dir"
   mkdir -p "$dir"
-  for tool in "$host_bin"/rsg_*; do ln -s "$tool" "$dir/"; done
+  for tool in "$host_build"/bin/rsg_* "$host_build"/tests/bin/rsg_*; do ln -s "$tool" "$dir/"; done
   for tool in "$@"; do
+    path=$chroot_build/bin/$tool
+    [[ -e $path ]] || path=$chroot_build/tests/bin/$tool
     rm -f "$dir/$tool"
-    printf '#!/bin/sh\nexec %s in %s "$@"\n' "$checkout/tools/fastdds3/chroot.sh" "$chroot_bin/$tool" > "$dir/$tool"
+    printf '#!/bin/sh\nexec %s in %s "$@"\n' "$checkout/tools/fastdds3/chroot.sh" "$path" > "$dir/$tool"
     chmod +x "$dir/$tool"
   done
 }
@@ -141,7 +146,7 @@ case ${1:-} in
   setup) setup ;;
   mixed)
     shift
-    (($# >= 4)) || die "usage: $0 mixed DIR HOST_BIN CHROOT_BIN TOOL..."
+    (($# >= 4)) || die "usage: $0 mixed DIR HOST_BUILD CHROOT_BUILD TOOL..."
     mixed "$@"
     ;;
   run | in)
@@ -155,5 +160,5 @@ case ${1:-} in
     shift
     if [[ $mode == in ]]; then in_chroot "$@"; else RSG_TRIXIE_ROOT=$root "$@"; fi
     ;;
-  *) die "usage: $0 setup | run CMD... | in CMD... | mixed DIR HOST_BIN CHROOT_BIN TOOL..." ;;
+  *) die "usage: $0 setup | run CMD... | in CMD... | mixed DIR HOST_BUILD CHROOT_BUILD TOOL..." ;;
 esac

@@ -1,13 +1,22 @@
 // rsg_record: subscribes to RobotState (whole or through a view) and GatewayStatus, and writes
 // every sample to an MCAP file as the CDR bytes a DDS writer sends, with the schema to decode them.
 //
+// With --trigger it records only around events (SIGUSR1, the gateway's link going down, invalid
+// frames): the last
+// --pre seconds of samples wait in memory, bounded by --trigger-buffer, and an event writes them and
+// the --post seconds after it to a file of their own.
+//
 // Exit status: 0 after --duration or on SIGINT/SIGTERM with the file finished; 1 when the file
 // cannot be written (the error names it; what was recorded stays readable), DDS fails or no writer
 // of the topic ever matched (a wrong domain or partition: the file holds no state); 2 on
 // usage errors (including unknown profiles). With --recover FILE: 0 when FILE was read to its end
 // or cut off (a killed recorder's file), 1 when it is damaged inside or --out cannot be written.
+#include <pthread.h>
+
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <deque>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
@@ -29,6 +38,7 @@
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/views.hpp"
+#include "status/status_sample.hpp"
 
 namespace {
 
@@ -59,6 +69,40 @@ struct Options : rsg::app::MonitorOptions {
   std::size_t chunk_bytes = rsg::mcap::WriterOptions{}.chunk_bytes;
   bool fsync = false;
   fs::path recover;  // --recover: copy this damaged file to --out instead of recording
+  // --trigger: files only around events, each with the --pre seconds before it and --post after.
+  std::vector<std::string> triggers;
+  double pre_s = 10;
+  double post_s = 10;
+  double trigger_buffer_mb = 64;  // what the --pre window may hold in memory
+
+  bool triggered() const { return !triggers.empty(); }
+  bool trigger_on(std::string_view what) const {
+    return std::find(triggers.begin(), triggers.end(), what) != triggers.end();
+  }
+};
+
+/// --trigger signal: SIGUSR1, blocked in every thread (before DDS starts its threads) and taken by
+/// the recording loop without waiting, as StopOnSignal takes the stop signals: no handler.
+class TriggerSignal {
+ public:
+  static void block() {
+    const sigset_t signals = usr1();
+    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  }
+  /// True once per SIGUSR1 that arrived since the last call (signals of one kind merge while pending).
+  static bool take() {
+    const sigset_t signals = usr1();
+    const timespec now{0, 0};
+    return sigtimedwait(&signals, nullptr, &now) == SIGUSR1;
+  }
+
+ private:
+  static sigset_t usr1() {
+    sigset_t signals;
+    sigemptyset(&signals);
+    sigaddset(&signals, SIGUSR1);
+    return signals;
+  }
 };
 
 std::uint64_t now_ns() {
@@ -67,17 +111,30 @@ std::uint64_t now_ns() {
                                         .count());
 }
 
-/// One MCAP file after another (with --split-size), each complete with its own schemas and channels.
-/// Samples are written in publication order (PublicationOrder: held until `kHold` after their
-/// arrival), their log times raised where that order puts a later-received sample first.
+/// One MCAP file after another (with --split-size, or one per event with --trigger), each complete
+/// with its own schemas and channels. Samples are written in publication order (PublicationOrder:
+/// held until `kHold` after their arrival), their log times raised where that order puts a
+/// later-received sample first.
 class Recording {
  public:
   Recording(const Options& options, rsg::app::Profile profile)
       : options_(options),
         profile_(profile),
         split_bytes_(static_cast<std::uint64_t>(options.split_mb * 1e6)),
+        numbered_(split_bytes_ != 0 || options.triggered()),
+        pre_ns_(static_cast<std::uint64_t>(options.pre_s * 1e9)),
+        post_ns_(static_cast<std::uint64_t>(options.post_s * 1e9)),
+        buffer_bytes_(static_cast<std::uint64_t>(options.trigger_buffer_mb * 1e6)),
         order_(kHold) {
-    open();
+    if (!options.triggered()) {
+      open();
+      return;
+    }
+    // A triggered recording takes samples before it opens a file: the channel ids every file gets
+    // from add_channels (the state's first, then the status's), checked as each file is opened.
+    const bool status = !options.status_topic.empty() &&
+                        (profile == rsg::app::Profile::omgidl || rsg::app::has_ros2_status_schema());
+    channels_ = {.robot_state = 1, .status = static_cast<std::uint16_t>(status ? 2 : 0)};
   }
 
   /// Adds a sample to those waiting for their place in the file.
@@ -90,6 +147,37 @@ class Recording {
     if (channels_.status == 0) return;
     ++statuses;
     add(channels_.status, true, serializer_.serialize(sample), info);
+    // --trigger link-down: the link going from up to down (not a gateway that starts without its robot).
+    if (options_.trigger_on("link-down")) {
+      if (link_up_.value_or(false) && !sample.link_up()) trigger(log_time_of(info), "the link went down");
+      link_up_ = sample.link_up();
+    }
+    // --trigger invalid: the gateway counted invalid frames since its previous status sample (the
+    // counters are totals: the first sample only sets the baseline).
+    if (options_.trigger_on("invalid")) {
+      const std::uint64_t invalid = rsg::status::from_status_sample(sample).ingress.invalid_total();
+      if (invalid_ && invalid > *invalid_)
+        trigger(log_time_of(info), fmt::format("{} invalid frames", invalid - *invalid_));
+      invalid_ = invalid;
+    }
+  }
+
+  /// --trigger: an event at `at_ns` (log-time clock). Opens the event's file with what the --pre
+  /// window holds of the time before, and records until --post after it; an event while one is
+  /// being recorded extends it.
+  void trigger(std::uint64_t at_ns, std::string_view why) {
+    ++triggers;
+    event_end_ = std::max(event_end_, at_ns + post_ns_);
+    if (writer_) {
+      spdlog::info("{}: event {} extended to {:g} s after it", why, events - 1, options_.post_s);
+      return;
+    }
+    ++events;
+    spdlog::info("{}: event {}, writing {} (up to {:g} s before, {:g} s after)", why, events - 1,
+                 next_path().string(), options_.pre_s, options_.post_s);
+    open();
+    for (const auto& sample : pre_)
+      if (sample.log_time + pre_ns_ >= at_ns) write_to_file(sample, sample.log_time);
   }
 
   /// Writes what is due at `now` in publication order. A sample placed after one received later is
@@ -99,7 +187,12 @@ class Recording {
     order_.release(now, [this](const rsg::app::PublicationOrder::Sample& sample) { write(sample); });
   }
   void tick() {
-    if (writer_) writer_->finish_chunk_if_older(now_ns());
+    const std::uint64_t now = now_ns();
+    if (writer_) writer_->finish_chunk_if_older(now);
+    // An event's last samples are out of PublicationOrder `kHold` after they arrived.
+    if (options_.triggered() && writer_ &&
+        now >= event_end_ + static_cast<std::uint64_t>(std::chrono::nanoseconds(kHold).count()))
+      finish_event();
     if (options_.max_age_s > 0) apply_retention();
   }
 
@@ -110,7 +203,8 @@ class Recording {
     writer_.reset();
   }
 
-  /// Writes every sample still held and finishes the current file. Throws mcap::WriteError.
+  /// Writes every sample still held and finishes the current file (--trigger: the event being
+  /// recorded, if any; the --pre window is left out). Throws mcap::WriteError.
   void close() {
     order_.release_all([this](const rsg::app::PublicationOrder::Sample& sample) { write(sample); });
     if (writer_) finish_file(true);
@@ -124,7 +218,9 @@ class Recording {
   std::uint64_t syncs = 0, sync_ns = 0;                                                      // --fsync
   std::uint64_t raised = 0;  // log times raised to the latest one written
   std::size_t files = 0;
-  std::size_t removed = 0;  // by retention
+  std::size_t removed = 0;                 // by retention
+  std::uint64_t triggers = 0, events = 0;  // --trigger: events recorded (a trigger during one extends it)
+  std::uint64_t pre_dropped = 0;           // left out of the --pre window by --trigger-buffer
 
  private:
   struct Finished {
@@ -135,7 +231,7 @@ class Recording {
 
   fs::path next_path() const { return next_path_of(files); }
   fs::path next_path_of(std::size_t index) const {
-    if (split_bytes_ == 0) return options_.out;
+    if (!numbered_) return options_.out;
     fs::path path = options_.out;
     path.replace_filename(options_.out.stem().string() + "_" + std::to_string(index) +
                           options_.out.extension().string());
@@ -148,16 +244,28 @@ class Recording {
                                                    .library = "rsg_record",
                                                    .chunk_bytes = options_.chunk_bytes,
                                                    .sync = options_.fsync});
-    channels_ = rsg::app::add_channels(*writer_, profile_, options_.topic, options_.status_topic);
+    const auto channels = rsg::app::add_channels(*writer_, profile_, options_.topic, options_.status_topic);
+    if (options_.triggered() &&
+        (channels.robot_state != channels_.robot_state || channels.status != channels_.status))
+      throw std::logic_error(
+          "rsg_record: a file's channel ids differ from those of the samples taken before it");
+    channels_ = channels;
     ++files;
     if (split_bytes_ != 0) spdlog::info("writing {}", path.string());
+  }
+
+  void finish_event() {
+    const fs::path path = next_path_of(files - 1);
+    const std::uint64_t before = messages;
+    finish_file(false);
+    spdlog::info("event {} recorded: {} ({} messages)", events - 1, path.string(), messages - before);
   }
 
   /// `last`: no file follows (the recording ends), so retention keeps no room for one.
   void finish_file(bool last) {
     writer_->close();
     add_totals();
-    if (split_bytes_ != 0)
+    if (numbered_)
       finished_.push_back(
           {next_path_of(files - 1), writer_->totals().file_bytes, std::chrono::steady_clock::now()});
     writer_.reset();
@@ -209,12 +317,16 @@ class Recording {
     sync_ns += totals.sync_ns;
   }
 
+  // Log time: when DDS received the sample (not when it was taken).
+  static std::uint64_t log_time_of(const fdds::SampleInfo& info) {
+    const std::int64_t reception_time = info.reception_timestamp.to_ns();
+    return reception_time > 0 ? static_cast<std::uint64_t>(reception_time) : now_ns();
+  }
+
   void add(std::uint16_t channel, bool contiguous, std::span<const std::uint8_t> payload,
            const fdds::SampleInfo& info) {
-    // Log time: when DDS received the sample (not when it was taken); publish time: when the
-    // gateway wrote it, the robot's frame timing that rsg_replay reproduces.
-    const std::int64_t reception_time = info.reception_timestamp.to_ns();
-    const std::uint64_t log_time = reception_time > 0 ? static_cast<std::uint64_t>(reception_time) : now_ns();
+    // Publish time: when the gateway wrote it, the robot's frame timing that rsg_replay reproduces.
+    const std::uint64_t log_time = log_time_of(info);
     const std::int64_t source_time = info.source_timestamp.to_ns();
     const std::uint64_t publish_time = source_time > 0 ? static_cast<std::uint64_t>(source_time) : log_time;
     const auto& guid = info.sample_identity.writer_guid();
@@ -238,12 +350,53 @@ class Recording {
     }
     last_log_time_ = log_time;
     if (sample.channel == channels_.robot_state) ++states_written;
+    if (options_.triggered()) {
+      if (writer_ && log_time > event_end_) finish_event();
+      if (writer_) write_to_file(sample, log_time);
+      // Kept during an event too: an event soon after this one gets its whole --pre window as well.
+      keep_for_an_event(sample, log_time);
+      return;
+    }
     // After a split the next file is opened by the next message, so that none is left empty.
     if (!writer_) open();
+    write_to_file(sample, log_time);
+    if (split_bytes_ != 0 && writer_->totals().file_bytes >= split_bytes_) finish_file(false);
+  }
+
+  void write_to_file(const rsg::app::PublicationOrder::Sample& sample, std::uint64_t log_time) {
     // The DDS sequence number (its low 32 bits: MCAP's field) lets a reader of the file see gaps.
     writer_->write(sample.channel, static_cast<std::uint32_t>(sample.sequence), log_time, sample.publish_time,
                    sample.payload);
-    if (split_bytes_ != 0 && writer_->totals().file_bytes >= split_bytes_) finish_file(false);
+  }
+
+  /// The --pre window: the samples of the last --pre seconds, within --trigger-buffer bytes (the
+  /// oldest go first when a fast stream would need more).
+  void keep_for_an_event(const rsg::app::PublicationOrder::Sample& sample, std::uint64_t log_time) {
+    pre_.push_back(sample);
+    pre_.back().log_time = log_time;
+    pre_bytes_ += footprint(sample);
+    while (!pre_.empty() && pre_.front().log_time + pre_ns_ < log_time) drop_oldest();
+    bool over = false;
+    while (!pre_.empty() && pre_bytes_ > buffer_bytes_) {
+      drop_oldest();
+      ++pre_dropped;
+      over = true;
+    }
+    if (over && !warned_buffer_) {
+      warned_buffer_ = true;
+      spdlog::warn(
+          "--trigger-buffer {:g} MB holds {:.2f} s of this stream, less than --pre {:g}: an event "
+          "file starts that long before its event",
+          options_.trigger_buffer_mb,
+          pre_.empty() ? 0.0 : static_cast<double>(log_time - pre_.front().log_time) / 1e9, options_.pre_s);
+    }
+  }
+  static std::uint64_t footprint(const rsg::app::PublicationOrder::Sample& sample) {
+    return sizeof(sample) + sample.payload.capacity();
+  }
+  void drop_oldest() {
+    pre_bytes_ -= footprint(pre_.front());
+    pre_.pop_front();
   }
 
   const Options& options_;
@@ -252,9 +405,17 @@ class Recording {
   std::optional<rsg::mcap::Writer> writer_;
   rsg::app::Channels channels_;
   rsg::app::CdrSerializer serializer_;
+  bool numbered_;  // FILE_0.mcap, FILE_1.mcap, ... (--split-size, --trigger)
+  std::uint64_t pre_ns_, post_ns_, buffer_bytes_;
   rsg::app::PublicationOrder order_;
   std::uint64_t last_log_time_ = 0;
-  std::deque<Finished> finished_;  // with --split-size, oldest first, not yet removed
+  std::deque<Finished> finished_;  // with --split-size or --trigger, oldest first, not yet removed
+  std::deque<rsg::app::PublicationOrder::Sample> pre_;  // --trigger: the --pre window, oldest first
+  std::uint64_t pre_bytes_ = 0;
+  bool warned_buffer_ = false;
+  std::uint64_t event_end_ = 0;           // --trigger: the log time up to which the current event records
+  std::optional<bool> link_up_;           // --trigger link-down: as the last status sample said
+  std::optional<std::uint64_t> invalid_;  // --trigger invalid: the last status sample's total
 };
 
 void add_options(CLI::App& app, Options& options) {
@@ -275,23 +436,48 @@ void add_options(CLI::App& app, Options& options) {
       app.add_option("--split-size", options.split_mb,
                      "Start a new file when one reaches this many MB: FILE_0.mcap, FILE_1.mcap, ...")
           ->check(CLI::NonNegativeNumber);
+  // Record only around events, as the gateway's flight recorder keeps its datagrams: a recorder left
+  // running writes nothing until something happens.
+  auto* trigger =
+      app.add_option("--trigger", options.triggers,
+                     "Record only around events: signal (SIGUSR1), link-down (the gateway's status says "
+                     "its link went down), invalid (it counted invalid frames since its previous status); "
+                     "each event gets a file FILE_0.mcap, FILE_1.mcap, ... with --pre "
+                     "seconds before it and --post after (an event meanwhile extends it)")
+          ->check(CLI::IsMember({"signal", "link-down", "invalid"}))
+          ->delimiter(',')
+          ->excludes(split);
+  app.add_option("--pre", options.pre_s, "With --trigger: seconds recorded before an event")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str()
+      ->needs(trigger);
+  app.add_option("--post", options.post_s, "With --trigger: seconds recorded after an event")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str()
+      ->needs(trigger);
+  app.add_option("--trigger-buffer", options.trigger_buffer_mb,
+                 "With --trigger: MB of memory the --pre window may take (a faster stream keeps less than "
+                 "--pre seconds, with a warning)")
+      ->check(CLI::Range(0.1, 4096.0))
+      ->capture_default_str()
+      ->needs(trigger);
   // Retention, as rosbag2 users know it from storage limits: a recorder left running keeps the
-  // newest files within the limits instead of filling the disk.
+  // newest files within the limits instead of filling the disk (checked in main: with --split-size
+  // or --trigger).
   app.add_option(
          "--max-files", options.max_files,
-         "With --split-size: keep at most this many files (the one being written included), removing the "
-         "oldest")
-      ->check(CLI::Range(std::size_t{2}, std::numeric_limits<std::size_t>::max()))
-      ->needs(split);
-  app.add_option("--max-size", options.max_mb,
-                 "With --split-size: keep the files within about this many MB together, removing the oldest "
-                 "(room is kept for one more --split-size file)")
-      ->check(CLI::PositiveNumber)
-      ->needs(split);
+         "With --split-size or --trigger: keep at most this many files (the one being written included), "
+         "removing the oldest")
+      ->check(CLI::Range(std::size_t{2}, std::numeric_limits<std::size_t>::max()));
+  app.add_option(
+         "--max-size", options.max_mb,
+         "With --split-size or --trigger: keep the files within about this many MB together, removing "
+         "the oldest (room is kept for one more --split-size file)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--max-age", options.max_age_s,
-                 "With --split-size: remove a finished file this many seconds after it was finished")
-      ->check(CLI::PositiveNumber)
-      ->needs(split);
+                 "With --split-size or --trigger: remove a finished file this many seconds after it was "
+                 "finished")
+      ->check(CLI::PositiveNumber);
   app.add_option("--chunk-size", options.chunk_bytes,
                  "Finish a chunk when its records reach this many bytes before compression (or span 1 s): "
                  "smaller chunks lose less to a crash and seek finer, compress worse")
@@ -359,12 +545,14 @@ int run(const Options& options, rsg::app::Profile profile) {
     readers.state().get_sample_lost_status(lost);
     lost_before_first = lost.total_count;
   };
+  const bool trigger_on_signal = options.trigger_on("signal");
   try {
     while (!readers.stop_requested() &&
            (options.duration_s == 0 || std::chrono::steady_clock::now() - start < duration)) {
       readers.wait(kBatchPeriod);
       matched_writers.update(readers.state());
       take_what_was_received();
+      if (trigger_on_signal && TriggerSignal::take()) recording.trigger(now_ns(), "SIGUSR1");
       recording.write_due(now_ns());
       note_first_written();
       recording.tick();
@@ -398,6 +586,12 @@ int run(const Options& options, rsg::app::Profile profile) {
                            counts.before_start);
   if (recording.raised > 0)
     summary += fmt::format("; {} log times raised to keep their order", recording.raised);
+  if (options.triggered())
+    summary += fmt::format("; {} {} ({} {})", recording.events, recording.events == 1 ? "event" : "events",
+                           recording.triggers, recording.triggers == 1 ? "trigger" : "triggers");
+  if (recording.pre_dropped > 0)
+    summary +=
+        fmt::format("; {} samples of the --pre window left out (--trigger-buffer)", recording.pre_dropped);
   if (recording.removed > 0)
     summary += fmt::format("; {} oldest {} removed (retention)", recording.removed,
                            recording.removed == 1 ? "file" : "files");
@@ -424,6 +618,7 @@ int main(int argc, char** argv) {
   StopOnSignal::block_stop_signals();  // before Fast DDS starts threads (stop_on_signal.hpp)
   CLI::App app{"Records RobotState and GatewayStatus samples into an MCAP file.", "rsg_record"};
   app.footer(
+      "With --trigger signal, SIGUSR1 records an event. "
       "Exit status: 0 after --duration or on SIGINT/SIGTERM (the file finished), 1 when the file cannot be "
       "written (what was recorded stays readable), DDS fails or no writer of the topic matched, 2 usage "
       "error. --recover: 0 when FILE read "
@@ -447,6 +642,18 @@ int main(int argc, char** argv) {
           "this build has no ros2/rsg_msgs/msg/GatewayStatus.msg, so a --profile ros2 recording leaves "
           "'{}' out",
           options.status_topic);
+    if ((options.max_files != 0 || options.max_mb > 0 || options.max_age_s > 0) && options.split_mb == 0 &&
+        !options.triggered())
+      throw rsg::InputError(fmt::format("{} needs --split-size or --trigger: one file has nothing to remove",
+                                        options.max_files != 0 ? "--max-files"
+                                        : options.max_mb > 0   ? "--max-size"
+                                                               : "--max-age"));
+    for (const char* status_trigger : {"link-down", "invalid"})
+      if (options.trigger_on(status_trigger) && options.status_topic.empty())
+        throw rsg::InputError(fmt::format(
+            "--trigger {} reads the gateway's status: --status-topic must not be empty", status_trigger));
+    // Before DDS starts its threads (StopOnSignal::block_stop_signals() says why).
+    if (options.trigger_on("signal")) TriggerSignal::block();
     if (options.max_mb > 0 && options.max_mb < 2 * options.split_mb)
       throw rsg::InputError(
           fmt::format("--max-size {:g} keeps no finished file of --split-size {:g}: give at least {:g}",

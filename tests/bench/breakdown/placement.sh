@@ -48,7 +48,7 @@ apply() {
 
 for round in $(seq "$rounds"); do
   for mode in "${modes[@]}"; do
-    "$build/bin/rsg_bench_e2e" --scenario gateway_udp --duration "$seconds" --warmup 4 \
+    "$build/tests/bin/rsg_bench_e2e" --scenario gateway_udp --duration "$seconds" --warmup 4 \
       --out "$work/$mode.$round.json" >/dev/null 2>&1 &
     bench=$!
     apply "$mode" "$bench" || true

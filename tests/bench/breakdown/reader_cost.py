@@ -53,6 +53,8 @@ class ProfiledPoint(Point):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--bin", required=True)
+    parser.add_argument("--test-bin", help="directory of the bench's helpers (default: BIN/../tests/bin, the build "
+                                           "tree's: CONTRIBUTING.md, \"Build tree\")")
     parser.add_argument("--points", default="1,16")
     parser.add_argument("--seconds", type=float, default=6.0)
     parser.add_argument("--warmup", type=float, default=2.0)

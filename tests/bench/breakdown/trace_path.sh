@@ -19,7 +19,7 @@ command -v perf >/dev/null || { echo "trace_path.sh: perf is missing (apt-get in
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-"$build/bin/rsg_bench_e2e" --scenario "$scenario" --rate "$rate" --warmup 2 --duration "$seconds" \
+"$build/tests/bin/rsg_bench_e2e" --scenario "$scenario" --rate "$rate" --warmup 2 --duration "$seconds" \
   --out "$work/result.json" "${@:5}" > "$work/bench.log" 2>&1 &
 bench=$!
 sleep 1.5  # discovery; warm-up frames are flowing by the time the trace starts

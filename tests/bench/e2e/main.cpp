@@ -182,6 +182,7 @@ int main(int argc, char** argv) {
   BenchOptions options;
   options.domain = rsg::test::test_domain();
   options.bin_dir = own_directory();
+  options.tools_dir = RSG_TOOLS_DIR;
   options.profiles_dir = rsg::dds::default_profiles_dir();
   std::filesystem::path bench_profiles = RSG_BENCH_PROFILES;
   std::string scenario, role, transport = "udp", out;
@@ -192,6 +193,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> names;
   for (const auto& entry : scenarios({}, {})) names.push_back(entry.first);
   app.add_option("--scenario", scenario, "What to measure")->check(CLI::IsMember(names));
+  app.add_option("--bin", options.tools_dir, "Directory of the rsg_gateway measured")->capture_default_str();
   app.add_flag("--smoke", smoke, "Send a few hundred frames through the gateway; fail unless they arrive");
   app.add_option("--rate", options.rate_hz, "Frames per second")->capture_default_str();
   app.add_option("--duration", options.duration_s, "Seconds measured (per step for max_rate)")

@@ -188,7 +188,7 @@ class GatewayProcess {
   GatewayProcess(const BenchOptions& options, const Transport& transport, const std::string& topic,
                  const std::string& label)
       : GatewayProcess(
-            {(options.bin_dir / "rsg_gateway").string(), "--listen", "127.0.0.1:0", "--domain",
+            {(options.tools_dir / "rsg_gateway").string(), "--listen", "127.0.0.1:0", "--domain",
              std::to_string(options.domain), "--topic", topic, "--status-topic", topic + "_status",
              "--profiles", options.profiles_dir.string(), "--participant-profile",
              std::string(transport.participant_profile), "--writer-profile", options.writer_profile,
@@ -414,7 +414,7 @@ json run_floor(const BenchOptions& options, std::string_view publisher, std::str
             "bench_relay_writer"};
   } else {
     stats = options.scratch_dir / ("gateway_" + label + "_stats.json");
-    argv = {(options.bin_dir / "rsg_gateway").string(),
+    argv = {(options.tools_dir / "rsg_gateway").string(),
             "--listen",
             "127.0.0.1:0",
             "--domain",

@@ -39,7 +39,8 @@ struct BenchOptions {
   std::string reader_profile_for(const Transport& transport) const {
     return reader_profile.empty() ? std::string(transport.reader_profile) : reader_profile;
   }
-  std::filesystem::path bin_dir;       ///< rsg_gateway and this binary
+  std::filesystem::path bin_dir;       ///< this binary and the bench's other executables (build/tests/bin)
+  std::filesystem::path tools_dir;     ///< rsg_gateway (build/bin: CONTRIBUTING.md, "Build tree")
   std::filesystem::path profiles_dir;  ///< every profile, the gateway's and the bench's (see Scratch)
   std::filesystem::path scratch_dir;   ///< logs and stats files of the children
   std::filesystem::path cdf_file;      ///< where to write the latency CDF; empty: nowhere

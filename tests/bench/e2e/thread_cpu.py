@@ -2,8 +2,8 @@
 """Per-thread CPU and wake-ups of rsg_gateway during one rsg_bench_e2e gateway run
 (docs/benchmarks/latency_breakdown.md, "Gateway CPU at 1 kHz, thread by thread").
 
-usage: thread_cpu.py BUILD_BIN_DIR SCENARIO DURATION [more rsg_bench_e2e args...]
-  e.g. thread_cpu.py build/bin gateway_udp 20 --writer-profile bench_writer_nack_supression_10ms
+usage: thread_cpu.py TESTS_BIN_DIR SCENARIO DURATION [more rsg_bench_e2e args...]
+  e.g. thread_cpu.py build/tests/bin gateway_udp 20 --writer-profile bench_writer_nack_supression_10ms
 
 Reads utime+stime and context switches of every gateway thread from /proc over the middle of the
 measured part, then names the threads from their stacks (gdb attaches after the measured part;

@@ -91,7 +91,7 @@ def run_point(args, kind, count, domain, scratch):
     try:
         wait_for(lambda: read_json(stats), "the gateway to start")
         if host:
-            readers = subprocess.Popen([str(Path(args.bin) / "rsg_bench_reader_host"),
+            readers = subprocess.Popen([str(Path(args.test_bin) / "rsg_bench_reader_host"),
                                         "--domain", str(domain), "--ros2", "--kind", kind, "--count", str(count),
                                         "--send-to", f"127.0.0.1:{port}", "--settle", "3", "--seconds", str(args.seconds),
                                         "--qos", args.reader_qos],
@@ -159,6 +159,8 @@ def run_point(args, kind, count, domain, scratch):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--bin", required=True)
+    parser.add_argument("--test-bin", help="directory of the bench's helpers (default: BIN/../tests/bin, the build "
+                                           "tree's: CONTRIBUTING.md, \"Build tree\")")
     parser.add_argument("--gateway", help="rsg_gateway to measure (default: BIN/rsg_gateway)")
     parser.add_argument("--label", default="fastdds2.9")
     parser.add_argument("--counts", default="0,1,4,16")
@@ -170,6 +172,7 @@ def main():
                              "(a gateway of another Fast DDS version: 2.9/3.x data-sharing aborts the writer)")
     args = parser.parse_args()
     args.gateway = args.gateway or str(Path(args.bin) / "rsg_gateway")
+    args.test_bin = args.test_bin or str(Path(args.bin).parent / "tests" / "bin")
     counts = [int(c) for c in args.counts.split(",")]
     kinds = args.kinds.split(",")
     points = []

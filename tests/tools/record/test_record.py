@@ -511,9 +511,92 @@ def retention(h):
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
 
 
+def trigger(h):
+    """--trigger: nothing is written before an event. SIGUSR1 writes the --pre seconds before it and
+    the --post seconds after it to FILE_0.mcap, the frames exact and in order (another SIGUSR1 just
+    after that event gets FILE_1.mcap, with its whole --pre window); the gateway's link going
+    down is an event too (every flap of a loaded host's stream as well), the last file ending with the
+    last frame, and so are invalid frames the gateway counted (here from rsg_flood, beside the
+    stream); --trigger-buffer bounds the --pre window in memory (the file then starts later, with a
+    warning)."""
+    port, gateway, stats, rec, out = gateway_with_recorder(h, "--trigger", "signal", "--pre", "1", "--post", "1")
+    down = recorder(h, "record_down", h.dir / "down.mcap", "--trigger", "link-down", "--pre", "1", "--post", "0.5")
+    small = recorder(h, "record_small", h.dir / "small.mcap", "--trigger", "signal", "--pre", "5", "--post", "1",
+                     "--trigger-buffer", "0.5", "--status-topic", "")
+    # The gateway's status, once a second, says what it counted: the event comes up to a second after
+    # the invalid frames, so --pre covers that second too.
+    invalid = recorder(h, "record_invalid", h.dir / "invalid.mcap", "--trigger", "invalid", "--pre", "2", "--post",
+                       "0.5")
+    wait_matched(h, stats, ["record", "record_down", "record_small", "record_invalid"], "rsg_record")
+    count, record = 5000, h.dir / "sim.record.jsonl"
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", str(count),
+                          "--record", str(record)])
+    wait_for_stats(stats, lambda s: s["frames_published"] >= 2000, "2 s of the stream")
+    early = [path for name in ("run", "small", "invalid") for path in h.dir.glob(f"{name}_*.mcap")]
+    check(not early, f"a triggered recorder wrote before its event: {early}")
+    rec.send_signal(signal.SIGUSR1)
+    small.send_signal(signal.SIGUSR1)
+    check(h.run("flood", [h.binary("rsg_flood"), "--to", f"127.0.0.1:{port}", "--count", "5", "--sizes", "10"]) == 0,
+          "rsg_flood failed")
+    # Another event right after one (the stream still running): its file has the whole --pre window
+    # too, overlapping the first's.
+    wait_for(lambda: "event 0 recorded" in stderr_of(h, "record"), "the file of the first SIGUSR1", timeout_s=20)
+    rec.send_signal(signal.SIGUSR1)
+    wait_for(lambda: all("event 0 recorded" in stderr_of(h, label) for label in ("record_small", "record_invalid")),
+             "the files of the other SIGUSR1 and the invalid-frame events", timeout_s=20)
+    wait_for(lambda: "event 1 recorded" in stderr_of(h, "record"), "the file of the second SIGUSR1", timeout_s=20)
+    check(h.wait("sim", sim, 30) == 0, "rsg_sim failed")
+    wait_for_stats(stats, lambda s: not s["link_up"], "the gateway to see the link down")
+    # Its status sample reaches the recorder, whose event ends --post (0.5 s) and the order's hold
+    # (0.5 s) after it: by then every event it started is recorded.
+    time.sleep(1.5)
+
+    def events_recorded():
+        err = stderr_of(h, "record_down")
+        return err.count(", writing ") == err.count(" recorded: ") > 0
+    wait_for(events_recorded, "the file of the link-down event", timeout_s=20)
+    for label, process in (("record", rec), ("record_down", down), ("record_small", small),
+                           ("record_invalid", invalid)):
+        check(h.stop(label, process) == 0, f"{label} did not exit 0: {stderr_of(h, label)}")
+    files = sorted(path.name for path in h.dir.glob("*.mcap") if not path.name.startswith("down_"))
+    check(files == ["invalid_0.mcap", "run_0.mcap", "run_1.mcap", "small_0.mcap"], f"the events wrote {files}")
+    check("; 2 events (2 triggers)" in stderr_of(h, "record"), stderr_of(h, "record"))
+
+    def in_order(path, values=False):
+        """Read by the reference reader: states in sequence order, and with `values` the frames sent."""
+        seen = node_check(h, path)
+        check(seen["states"] > 0 and seen["sequence_breaks"] == 0, f"{path.name}: {seen}")
+        if values:
+            node_check(h, path, "--frames", record, "--skip", seen["first_sequence"] - 1)
+        return seen
+
+    signalled = in_order(h.dir / "run_0.mcap", values=True)
+    check(1500 <= signalled["states"] <= 2500 and signalled["statuses"] >= 1,
+          f"--pre 1 --post 1 of a 1 kHz stream: {signalled}")
+    again = in_order(h.dir / "run_1.mcap")
+    check(again["states"] >= 800 and again["first_sequence"] < signalled["first_sequence"] + signalled["states"],
+          f"the second event's file {again} after the first's {signalled}")
+    downs = sorted(h.dir.glob("down_*.mcap"), key=lambda path: int(path.stem.split("_")[1]))
+    last = in_order(downs[-1], values=True)
+    check(last["first_sequence"] - 1 + last["states"] == count and last["statuses"] >= 1,
+          f"the link-down event's file of a stream that stopped at frame {count}: {last}")
+    check("the link went down: event 0" in stderr_of(h, "record_down"), stderr_of(h, "record_down"))
+    flooded = in_order(h.dir / "invalid_0.mcap")
+    err = stderr_of(h, "record_invalid")
+    check("invalid frames: event 0" in err and "; 1 event (" in err and flooded["statuses"] >= 1,
+          f"{flooded}: {err}")
+    # Unbounded, 2 s before the event and 1 s after; 0.5 MB holds well under a second of full frames
+    # (the last 0.5 s before the event wait in the publication-order hold, not in the window).
+    bounded = in_order(h.dir / "small_0.mcap")
+    err = stderr_of(h, "record_small")
+    check(bounded["states"] < 2500 and "--trigger-buffer 0.5 MB holds" in err
+          and "samples of the --pre window left out (--trigger-buffer)" in err, f"{bounded}: {err}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
 CASES = {f.__name__: f for f in (reference_reader, sigkill, write_errors, replay_roundtrip, split_and_view, duration,
                                  ros2_profile, chunk_size_fsync, drain_on_sigterm, mid_stream_under_load, no_writer,
-                                 retention)}
+                                 retention, trigger)}
 
 if __name__ == "__main__":
     sys.exit(main(f"record_{CASE}", CASES[CASE]))
