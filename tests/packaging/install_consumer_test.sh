@@ -19,6 +19,14 @@ for header in $installed; do
 done
 # No installed header reaches for what is not installed (src/<layer>/internal/, CONTRIBUTING.md).
 if grep -rn '#include "[a-z]*/internal/' "$work/prefix/include"; then echo "FAIL: an installed header includes an internal one"; exit 1; fi
+# The package exports what a consumer links and nothing internal (CONTRIBUTING.md, "Layers"): the
+# gateway's internals travel inside rsg::embedded_gateway's archive, the generated types inside rsg::dds's.
+exported=$(cat "$work"/prefix/lib*/cmake/rsg/rsg*Targets.cmake | sed -n 's/^add_library(\(rsg::[a-z_]*\) .*/\1/p' | sort | tr '\n' ' ')
+[[ "$exported" == "rsg::dds rsg::eigen rsg::embedded_gateway rsg::transport rsg::wire " ]] ||
+  { echo "FAIL: the package exports $exported"; exit 1; }
+archives=$(cd "$work"/prefix/lib* && ls *.a | sort | tr '\n' ' ')
+[[ "$archives" == "librsg_dds.a librsg_embedded_gateway.a librsg_transport.a librsg_wire.a " ]] ||
+  { echo "FAIL: the archives installed are $archives"; exit 1; }
 for tool in rsg_gateway rsg_sim rsg_echo rsg_frame rsg_record rsg_replay rsg_view; do
   [[ -x "$work/prefix/bin/$tool" ]] || { echo "FAIL: $tool not installed"; exit 1; }
 done
