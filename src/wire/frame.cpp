@@ -21,7 +21,7 @@ DecodeResult decode(std::span<const std::uint8_t> bytes) noexcept {
 }
 
 void copy_fields(const FrameView& frame, void* base, const FieldLayout& layout) noexcept {
-  const CopyPlan plan(frame.selection(), layout);
+  const detail::CopyPlan plan(frame.selection(), layout);
   detail::copy_to_struct(frame.bytes(), plan, static_cast<std::byte*>(base));
   detail::zero_fills(plan, base);
 }
@@ -33,7 +33,7 @@ EncodeResult encode(std::uint8_t packet_number, const Selection& selection, cons
   EncodeResult result;
   const std::size_t covered = detail::begin_encode(packet_number, selection, base, layout, out, result.error);
   if (covered == 0) return result;
-  detail::copy_to_frame(out, CopyPlan(selection, layout), static_cast<const std::byte*>(base));
+  detail::copy_to_frame(out, detail::CopyPlan(selection, layout), static_cast<const std::byte*>(base));
   result.size = detail::finish_encode(out, covered, crc32(out.first(covered)));
   return result;
 }

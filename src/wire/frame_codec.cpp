@@ -9,7 +9,7 @@ namespace rsg::wire {
 FrameCodec::FrameCodec(const FieldLayout& layout) noexcept
     : layout_(&layout), plan_(Selection{}, layout), plan_key_(detail::selection_key(Selection{})) {}
 
-const ChunkedCopyPlan& FrameCodec::plan_for(const Selection& selection, std::uint64_t key) noexcept {
+const detail::ChunkedCopyPlan& FrameCodec::plan_for(const Selection& selection, std::uint64_t key) noexcept {
   if (key != plan_key_) replan(selection, key);
   return plan_;
 }
@@ -17,7 +17,7 @@ const ChunkedCopyPlan& FrameCodec::plan_for(const Selection& selection, std::uin
 // Out of line: the plan under construction takes kilobytes of stack, which the per-frame path
 // should not have to set up.
 [[gnu::noinline]] void FrameCodec::replan(const Selection& selection, std::uint64_t key) noexcept {
-  plan_ = ChunkedCopyPlan(selection, *layout_);
+  plan_ = detail::ChunkedCopyPlan(selection, *layout_);
   plan_key_ = key;
 }
 
@@ -25,7 +25,7 @@ DecodeResult FrameCodec::decode(std::span<const std::uint8_t> bytes, void* base)
   return detail::FrameDecoder::decode(
       bytes, [&](std::span<const std::uint8_t> covered, const Selection* selection) {
         if (selection == nullptr) return crc32(covered);
-        const ChunkedCopyPlan& plan = plan_for(*selection, detail::selection_key(covered));
+        const detail::ChunkedCopyPlan& plan = plan_for(*selection, detail::selection_key(covered));
         detail::zero_fills(plan.plan(), base);
         return detail::crc32_scatter(covered, plan, static_cast<std::byte*>(base));
       });

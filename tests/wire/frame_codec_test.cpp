@@ -100,7 +100,7 @@ class KernelCase {
     expected_.assign(destination_.data() - kMargin, destination_.data() + destination_.size() + kMargin);
   }
 
-  const wire::ChunkedCopyPlan& plan() const { return plan_; }
+  const wire::detail::ChunkedCopyPlan& plan() const { return plan_; }
   std::span<std::uint8_t> frame() { return frame_; }
   std::byte* struct_base() { return struct_.data(); }
   /// The destination as the plain path sees it: inside the copy.
@@ -121,7 +121,7 @@ class KernelCase {
   wire::Selection selection_;
   std::size_t struct_size_ = 0;
   wire::FieldLayout layout_;
-  wire::ChunkedCopyPlan plan_;
+  wire::detail::ChunkedCopyPlan plan_;
   std::span<std::uint8_t> frame_;
   std::span<std::byte> struct_;
   std::span<std::byte> destination_;
@@ -168,7 +168,7 @@ TEST_F(StitchedKernel, EveryHeadPaddingASelectionCanHave) {
   std::set<std::size_t> paddings;
   for (int round = 0; round < 200'000; ++round) {
     const wire::Selection selection = random_selection(rng);
-    const wire::ChunkedCopyPlan plan(selection, wire::StateValues::layout());
+    const wire::detail::ChunkedCopyPlan plan(selection, wire::StateValues::layout());
     const std::size_t size = plan.plan().covered_bytes();
     if (size < 256 || !paddings.insert(plan.head_padding()).second) continue;
 
@@ -188,7 +188,7 @@ TEST_F(StitchedKernel, EveryHeadPaddingASelectionCanHave) {
 }
 
 TEST(CopyPlan, FullSelectionIsAFewMovesAndLeavesOnlyErrorSetHighBytes) {
-  const wire::CopyPlan plan(wire::Selection::all(), wire::StateValues::layout());
+  const wire::detail::CopyPlan plan(wire::Selection::all(), wire::StateValues::layout());
   // StateValues stores fields in table order; the two 5-byte error sets widen to 8 bytes, which
   // shifts what follows each: the doubles with current_errors, last_motion_errors, the rest.
   EXPECT_EQ(plan.moves().size(), 3U);
@@ -196,12 +196,12 @@ TEST(CopyPlan, FullSelectionIsAFewMovesAndLeavesOnlyErrorSetHighBytes) {
   EXPECT_EQ(plan.fills()[0].size, 3U);
   EXPECT_EQ(plan.fills()[1].size, 3U);
   EXPECT_EQ(plan.covered_bytes(), wire::kHeaderBytes + wire::kMaxDataBytes);
-  const wire::ChunkedCopyPlan chunked(wire::Selection::all(), wire::StateValues::layout());
-  EXPECT_EQ((plan.covered_bytes() + chunked.head_padding()) % wire::kChunkBytes, 0U);
+  const wire::detail::ChunkedCopyPlan chunked(wire::Selection::all(), wire::StateValues::layout());
+  EXPECT_EQ((plan.covered_bytes() + chunked.head_padding()) % wire::detail::kChunkBytes, 0U);
 }
 
 TEST(CopyPlan, EmptySelectionZeroesEverything) {
-  const wire::CopyPlan plan(wire::Selection{}, wire::StateValues::layout());
+  const wire::detail::CopyPlan plan(wire::Selection{}, wire::StateValues::layout());
   EXPECT_TRUE(plan.moves().empty());
   ASSERT_EQ(plan.fills().size(), 1U);
   EXPECT_EQ(plan.fills()[0].size, wire::StateValues::storage_size());

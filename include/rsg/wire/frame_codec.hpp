@@ -34,11 +34,11 @@ class FrameCodec {
                       std::span<std::uint8_t> out) noexcept;
 
  private:
-  const ChunkedCopyPlan& plan_for(const Selection& selection, std::uint64_t key) noexcept;
+  const detail::ChunkedCopyPlan& plan_for(const Selection& selection, std::uint64_t key) noexcept;
   void replan(const Selection& selection, std::uint64_t key) noexcept;
 
   const FieldLayout* layout_;
-  ChunkedCopyPlan plan_;
+  detail::ChunkedCopyPlan plan_;
   std::uint64_t plan_key_;  // plan_'s selection as 7 header bytes
 };
 
