@@ -29,7 +29,7 @@ std::string for_each_item(std::string_view list, OnItem&& on_item) {
 std::uint16_t Selection::data_bytes() const {
   std::uint16_t total = 0;
   for (std::size_t group = 0; group < kGroupCount; ++group)
-    total += detail::kSelectedBytes[group][data_select[group]];
+    total += internal::kSelectedBytes[group][data_select[group]];
   return total;
 }
 

@@ -76,7 +76,7 @@ void fill_random(std::span<std::byte> bytes, std::mt19937_64& rng) {
 class StitchedKernel : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!wire::detail::has_stitched_crc32()) GTEST_SKIP() << "no AVX-512 VPCLMULQDQ on this CPU";
+    if (!wire::internal::has_stitched_crc32()) GTEST_SKIP() << "no AVX-512 VPCLMULQDQ on this CPU";
   }
 };
 
@@ -134,9 +134,9 @@ TEST_F(StitchedKernel, ScatterMatchesIsalAndMemcpy) {
   for (int round = 0; round < 20'000; ++round) {
     KernelCase input(rng, arena, /*struct_is_destination=*/true);
     const std::uint32_t expected =
-        wire::detail::crc32_scatter_portable(input.frame(), input.plan(), input.expected_struct());
+        wire::internal::crc32_scatter_portable(input.frame(), input.plan(), input.expected_struct());
     const std::uint32_t actual =
-        wire::detail::crc32_scatter_stitched(input.frame(), input.plan(), input.struct_base());
+        wire::internal::crc32_scatter_stitched(input.frame(), input.plan(), input.struct_base());
     ASSERT_EQ(actual, wire::crc32(input.frame())) << "round " << round;
     ASSERT_EQ(actual, expected);
     ASSERT_TRUE(input.same_as_expected()) << "round " << round;
@@ -149,9 +149,9 @@ TEST_F(StitchedKernel, GatherMatchesMemcpyAndIsal) {
   for (int round = 0; round < 20'000; ++round) {
     KernelCase input(rng, arena, /*struct_is_destination=*/false);
     const std::uint32_t expected =
-        wire::detail::gather_crc32_portable(input.expected_frame(), input.plan(), input.struct_base());
+        wire::internal::gather_crc32_portable(input.expected_frame(), input.plan(), input.struct_base());
     const std::uint32_t actual =
-        wire::detail::gather_crc32_stitched(input.frame(), input.plan(), input.struct_base());
+        wire::internal::gather_crc32_stitched(input.frame(), input.plan(), input.struct_base());
     ASSERT_EQ(actual, expected) << "round " << round;
     ASSERT_EQ(actual, wire::crc32(input.frame()));
     ASSERT_TRUE(input.same_as_expected()) << "round " << round;
@@ -176,10 +176,11 @@ TEST_F(StitchedKernel, EveryHeadPaddingASelectionCanHave) {
     for (std::uint8_t& byte : covered) byte = static_cast<std::uint8_t>(rng());
     wire::StateValues expected;
     wire::StateValues actual;
-    EXPECT_EQ(wire::detail::crc32_scatter_stitched(covered, plan, static_cast<std::byte*>(actual.storage())),
-              wire::crc32(covered))
+    EXPECT_EQ(
+        wire::internal::crc32_scatter_stitched(covered, plan, static_cast<std::byte*>(actual.storage())),
+        wire::crc32(covered))
         << "padding " << plan.head_padding();
-    wire::detail::copy_to_struct(covered, plan.plan(), static_cast<std::byte*>(expected.storage()));
+    wire::internal::copy_to_struct(covered, plan.plan(), static_cast<std::byte*>(expected.storage()));
     EXPECT_EQ(std::memcmp(actual.storage(), expected.storage(), wire::StateValues::storage_size()), 0)
         << "padding " << plan.head_padding();
   }
