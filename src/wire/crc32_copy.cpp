@@ -1,4 +1,4 @@
-#include "wire/crc32_copy.hpp"
+#include "wire/internal/crc32_copy.hpp"
 
 #include <immintrin.h>
 

@@ -3,7 +3,7 @@
 #include <cstring>
 
 #include "rsg/wire/crc32.hpp"
-#include "wire/crc32_copy.hpp"
+#include "wire/internal/crc32_copy.hpp"
 #include "wire/frame_checks.hpp"
 
 namespace rsg::wire {

@@ -1,7 +1,7 @@
 #include "rsg/wire/frame_codec.hpp"
 
 #include "rsg/wire/crc32.hpp"
-#include "wire/crc32_copy.hpp"
+#include "wire/internal/crc32_copy.hpp"
 #include "wire/frame_checks.hpp"
 
 namespace rsg::wire {

@@ -20,7 +20,7 @@
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/state_values.hpp"
 #include "tests/support/random_state.hpp"
-#include "wire/crc32_copy.hpp"
+#include "wire/internal/crc32_copy.hpp"
 
 namespace rsg {
 namespace {

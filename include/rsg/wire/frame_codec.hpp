@@ -5,7 +5,7 @@
 //   if (!result) { count(result.error().category()); return; }   // `sample` holds garbage: drop it
 //
 // The same checks and results as `decode` followed by `copy_fields`, and `encode`, but the copy
-// and the CRC happen in the same pass over the bytes (see src/wire/crc32_copy.hpp), which costs
+// and the CRC happen in the same pass over the bytes (see src/wire/internal/crc32_copy.hpp), which costs
 // much less than two passes (measured in docs/benchmarks/wire.md). The codec keeps the copy plan
 // of the last selection it saw.
 #pragma once

@@ -69,7 +69,7 @@ class CopyPlan {
 };
 
 /// A copy plan's moves cut into 64-byte chunks, for a copy that goes a chunk at a time: the
-/// stitched CRC kernel (src/wire/crc32_copy.hpp). The chunks cover the CRC-covered bytes preceded
+/// stitched CRC kernel (src/wire/internal/crc32_copy.hpp). The chunks cover the CRC-covered bytes preceded
 /// by `head_padding()` zero bytes, so that they end where the frame ends; positions and deltas
 /// here count in that padded frame. Built once per selection and kept by `FrameCodec`.
 class ChunkedCopyPlan {
