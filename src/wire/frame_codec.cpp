@@ -2,7 +2,7 @@
 
 #include "rsg/wire/crc32.hpp"
 #include "wire/internal/crc32_copy.hpp"
-#include "wire/frame_checks.hpp"
+#include "wire/internal/frame_checks.hpp"
 
 namespace rsg::wire {
 
