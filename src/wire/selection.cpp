@@ -5,7 +5,7 @@
 
 #include "rsg/wire/number.hpp"
 #include "rsg/wire/text.hpp"
-#include "wire/group_bytes.hpp"
+#include "wire/internal/group_bytes.hpp"
 
 namespace rsg::wire {
 namespace {

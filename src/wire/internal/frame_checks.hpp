@@ -13,7 +13,7 @@
 #include "rsg/wire/detail/copy_plan.hpp"
 #include "rsg/wire/error_flags.hpp"
 #include "rsg/wire/frame.hpp"
-#include "wire/group_bytes.hpp"
+#include "wire/internal/group_bytes.hpp"
 
 namespace rsg::wire::internal {
 
