@@ -4,7 +4,7 @@
 #include <utility>
 
 #include "rsg/wire/number.hpp"
-#include "rsg/wire/text.hpp"
+#include "wire/internal/text.hpp"
 #include "wire/internal/group_bytes.hpp"
 
 namespace rsg::wire {

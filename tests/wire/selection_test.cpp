@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "rsg/wire/frame.hpp"
-#include "rsg/wire/text.hpp"
+#include "wire/internal/text.hpp"
 
 namespace rsg {
 namespace {

@@ -16,7 +16,7 @@
 #include "rsg/wire/hex.hpp"
 #include "rsg/wire/json.hpp"
 #include "rsg/wire/state_values.hpp"
-#include "rsg/wire/text.hpp"
+#include "wire/internal/text.hpp"
 
 namespace rsg::tools::frame {
 namespace {

@@ -1,7 +1,7 @@
 #include "tools/sim/schedule.hpp"
 
 #include "rsg/wire/number.hpp"
-#include "rsg/wire/text.hpp"
+#include "wire/internal/text.hpp"
 
 namespace rsg::tools::sim {
 namespace {
