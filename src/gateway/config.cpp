@@ -14,7 +14,7 @@
 #include "rsg/dds/ros2.hpp"
 #include "rsg/transport/host_port.hpp"
 #include "rsg/wire/frame.hpp"
-#include "rsg/wire/number.hpp"
+#include "wire/internal/number.hpp"
 
 namespace rsg::gateway {
 namespace {

@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "rsg/wire/number.hpp"
+#include "wire/internal/number.hpp"
 
 namespace rsg::gateway {
 namespace {

@@ -6,7 +6,7 @@
 #include <cstring>
 #include <optional>
 
-#include "rsg/wire/number.hpp"
+#include "wire/internal/number.hpp"
 
 namespace rsg::gateway {
 namespace {

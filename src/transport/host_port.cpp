@@ -3,7 +3,7 @@
 #include <optional>
 #include <utility>
 
-#include "rsg/wire/number.hpp"
+#include "wire/internal/number.hpp"
 
 namespace rsg::transport {
 

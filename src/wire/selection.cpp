@@ -3,7 +3,7 @@
 #include <string>
 #include <utility>
 
-#include "rsg/wire/number.hpp"
+#include "wire/internal/number.hpp"
 #include "wire/internal/text.hpp"
 #include "wire/internal/group_bytes.hpp"
 

@@ -1,6 +1,6 @@
 #include "tools/sim/schedule.hpp"
 
-#include "rsg/wire/number.hpp"
+#include "wire/internal/number.hpp"
 #include "wire/internal/text.hpp"
 
 namespace rsg::tools::sim {
