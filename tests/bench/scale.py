@@ -61,7 +61,6 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "net"))
 from netbed import HOSTS, NetBed, discovery_server_argv  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "support"))
 from test_domain import acquire_domain  # noqa: E402
 
 RAW_PORT = 17000

@@ -25,7 +25,6 @@ import threading
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "ros2"))
 from harness import (check, free_udp_port, main, read_json, read_json_lines, realtime_prefix, wait_for,  # noqa: E402
                      wait_for_stats)

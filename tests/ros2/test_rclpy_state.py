@@ -17,9 +17,7 @@ In the root namespace and in /robot1, fed by rsg_sim:
 """
 import json
 import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, free_udp_port, main, read_json_lines, wait_for_stats  # noqa: E402
 from rclpy_common import (RosEnv, expected_message, hash_hint, read_messages, same_message,  # noqa: E402
                           start_peer, wait_peer_matched)

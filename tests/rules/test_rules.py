@@ -13,6 +13,9 @@
   of src/ (never installed) declares a detail namespace; a layer with an installed API (wire,
   transport, dds) keeps every header of src/<layer>/ in src/<layer>/internal/, names in
   rsg::<layer>::internal.
+- python-path: no Python test puts tests/support or tests/integration on sys.path itself: the shared
+  helpers (tests/support) are imported by name, on the PYTHONPATH that tests/support/python.py sets
+  for ctest and the runners outside it export.
 - figure: no measured figure in a comment of src/ or include/: a number with a unit of time, a
   ratio or a throughput, written as measured ("~5 %") or next to words that say so ("measured",
   "took", "costs"). Figures go into docs/benchmarks/, and the comment points there.
@@ -38,6 +41,10 @@ NAMESPACE = re.compile(r"^namespace\s+([\w:]+)\s*\{", re.M)
 # The layers whose include/rsg/<layer>/ is the API of a client library; the gateway's one installed
 # header is the embedded gateway's facade, and the rest of src/gateway is its internals.
 API_LAYERS = ("wire", "transport", "dds")
+SYS_PATH_HELPERS = re.compile(r"sys\.path\.(?:insert|append)\(.*[\"'/](?:integration|support)[\"']")
+# The suites that run outside ctest in containers and put tests/support on their path themselves
+# (make test-image, make test-service), until their run.sh exports PYTHONPATH as the others do.
+SYS_PATH_OWN = {"tests/image/test_image.py", "tests/service/test_service.py"}
 MEASURED = re.compile(r"\b(measured|measures|took|costs?|costing)\b", re.I)
 
 
@@ -124,6 +131,17 @@ def check_private(root):
                     yield f"src/{relative}: private: namespace {name}: the headers of src/{layer}/ are rsg::{layer}::internal"
 
 
+def check_python_path(root):
+    for path in sorted((root / "tests").rglob("*.py")):
+        relative = path.relative_to(root).as_posix()
+        if "node_modules" in path.parts or relative in SYS_PATH_OWN:
+            continue
+        for number, line in enumerate(path.read_text(errors="replace").split("\n"), 1):
+            if SYS_PATH_HELPERS.search(line.split("#", 1)[0]):
+                yield (f"{relative}:{number}: python-path: a sys.path insert of tests/support or tests/integration; "
+                       "import the helper by name (tests/support is on PYTHONPATH: tests/support/python.py)")
+
+
 def check_figures(root):
     for path in sources(root, "src", "include"):
         for number, line in enumerate(path.read_text(errors="replace").split("\n"), 1):
@@ -137,9 +155,10 @@ def check_figures(root):
 
 def main():
     root = Path(sys.argv[1] if len(sys.argv) > 1 else Path(__file__).resolve().parents[2]).resolve()
-    failures = [*check_includes(root), *check_threads(root), *check_private(root), *check_figures(root)]
+    failures = [*check_includes(root), *check_threads(root), *check_private(root), *check_python_path(root),
+                *check_figures(root)]
     print("".join(f"FAIL: {failure}\n" for failure in failures) +
-          f"rules (include, thread, thread-name, private, figure) read over src/, include/, tests/, examples/: "
+          f"rules (include, thread, thread-name, private, python-path, figure) read over src/, include/, tests/, examples/: "
           f"{len(failures)} broken")
     return int(bool(failures))
 
