@@ -13,9 +13,9 @@
   of src/ (never installed) declares a detail namespace; a layer with an installed API (wire,
   transport, dds) keeps every header of src/<layer>/ in src/<layer>/internal/, names in
   rsg::<layer>::internal.
-- python-path: no Python test puts tests/support or tests/integration on sys.path itself: the shared
-  helpers (tests/support) are imported by name, on the PYTHONPATH that tests/support/python.py sets
-  for ctest and the runners outside it export.
+- python-path: no Python test puts tests/support, or the folder of another suite (integration, ros2,
+  net), on sys.path itself: the shared helpers (tests/support) are imported by name, on the
+  PYTHONPATH that tests/support/python.py sets for ctest and the runners outside it export.
 - figure: no measured figure in a comment of src/ or include/: a number with a unit of time, a
   ratio or a throughput, written as measured ("~5 %") or next to words that say so ("measured",
   "took", "costs"). Figures go into docs/benchmarks/, and the comment points there.
@@ -41,7 +41,7 @@ NAMESPACE = re.compile(r"^namespace\s+([\w:]+)\s*\{", re.M)
 # The layers whose include/rsg/<layer>/ is the API of a client library; the gateway's one installed
 # header is the embedded gateway's facade, and the rest of src/gateway is its internals.
 API_LAYERS = ("wire", "transport", "dds")
-SYS_PATH_HELPERS = re.compile(r"sys\.path\.(?:insert|append)\(.*[\"'/](?:integration|support)[\"']")
+SYS_PATH_HELPERS = re.compile(r"sys\.path\.(?:insert|append)\(.*[\"'/](?:integration|support|ros2|net)[\"']")
 # The suites that run outside ctest in containers and put tests/support on their path themselves
 # (make test-image, make test-service), until their run.sh exports PYTHONPATH as the others do.
 SYS_PATH_OWN = {"tests/image/test_image.py", "tests/service/test_service.py"}
@@ -138,7 +138,7 @@ def check_python_path(root):
             continue
         for number, line in enumerate(path.read_text(errors="replace").split("\n"), 1):
             if SYS_PATH_HELPERS.search(line.split("#", 1)[0]):
-                yield (f"{relative}:{number}: python-path: a sys.path insert of tests/support or tests/integration; "
+                yield (f"{relative}:{number}: python-path: a sys.path insert of tests/support or another suite's folder; "
                        "import the helper by name (tests/support is on PYTHONPATH: tests/support/python.py)")
 
 
