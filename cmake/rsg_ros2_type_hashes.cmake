@@ -23,6 +23,3 @@ add_custom_command(
 add_custom_target(rsg_ros2_type_hashes_header DEPENDS ${RSG_ROS2_TYPE_HASHES_HPP})
 add_library(rsg_ros2_type_hashes INTERFACE)
 add_dependencies(rsg_ros2_type_hashes rsg_ros2_type_hashes_header)
-# Header-only and build-tree-only; in the embedded gateway's export set because the installed
-# rsg_gateway_ingress (behind rsg::gateway::EmbeddedGateway) names it among its link dependencies.
-install(TARGETS rsg_ros2_type_hashes EXPORT rsgEmbeddedGatewayTargets)

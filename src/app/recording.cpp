@@ -80,8 +80,8 @@ struct CdrSerializer::Types {
 };
 
 CdrSerializer::CdrSerializer() : types_(std::make_unique<Types>()) {
-  types_->payload.reserve(
-      std::max(dds::max_serialized_size(types_->robot_state), dds::max_serialized_size(types_->status)));
+  types_->payload.reserve(std::max(dds::internal::max_serialized_size(types_->robot_state),
+                                   dds::internal::max_serialized_size(types_->status)));
   std::memset(types_->payload.data, 0, types_->payload.max_size);
 }
 
@@ -98,13 +98,13 @@ CdrSerializer::~CdrSerializer() = default;
 
 std::span<const std::uint8_t> CdrSerializer::serialize(const RobotState& sample) {
   clear_payload();
-  if (!dds::serialize(types_->robot_state, &sample, types_->payload)) return {};
+  if (!dds::internal::serialize(types_->robot_state, &sample, types_->payload)) return {};
   return {types_->payload.data, types_->payload.length};
 }
 
 std::span<const std::uint8_t> CdrSerializer::serialize(const GatewayStatus& sample) {
   clear_payload();
-  if (!dds::serialize(types_->status, &sample, types_->payload)) return {};
+  if (!dds::internal::serialize(types_->status, &sample, types_->payload)) return {};
   return {types_->payload.data, types_->payload.length};
 }
 
@@ -116,7 +116,7 @@ bool CdrSerializer::deserialize(std::span<const std::uint8_t> bytes, RobotState&
   payload.length = static_cast<std::uint32_t>(bytes.size());
   payload.pos = 0;
   try {
-    return dds::deserialize(types_->robot_state, payload, &sample);
+    return dds::internal::deserialize(types_->robot_state, payload, &sample);
   } catch (const eprosima::fastcdr::exception::Exception&) {  // e.g. an unknown encapsulation
     return false;
   }

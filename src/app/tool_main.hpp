@@ -32,7 +32,7 @@
 
 namespace rsg::app {
 
-namespace detail {
+namespace internal {
 
 // The `%*` of kToolPattern: "warning: " before a warning, nothing otherwise (an error is the
 // tool's last word and needs no label; an info line is what the tool did).
@@ -47,7 +47,7 @@ class WarningLabel final : public spdlog::custom_flag_formatter {
   std::unique_ptr<custom_flag_formatter> clone() const override { return std::make_unique<WarningLabel>(); }
 };
 
-}  // namespace detail
+}  // namespace internal
 
 /// Makes spdlog's default logger the executable's: every line on stderr, as "<tool>: <message>"
 /// ("<tool>: warning: <message>" for a warning), at level info. Call it first in main().
@@ -55,7 +55,7 @@ inline void init_logging(std::string_view tool) {
   auto logger =
       std::make_shared<spdlog::logger>(std::string(tool), std::make_shared<spdlog::sinks::stderr_sink_mt>());
   auto formatter = std::make_unique<spdlog::pattern_formatter>();
-  formatter->add_flag<detail::WarningLabel>('*').set_pattern("%n: %*%v");
+  formatter->add_flag<internal::WarningLabel>('*').set_pattern("%n: %*%v");
   logger->set_formatter(std::move(formatter));
   logger->flush_on(spdlog::level::trace);  // a line is written when it is logged, as std::cerr did
   spdlog::set_default_logger(std::move(logger));

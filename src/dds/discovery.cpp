@@ -45,10 +45,10 @@ void apply_discovery(const DiscoveryOptions& options, int domain,
     if (!parsed) throw InputError(parsed.error());
     const unsigned id = parsed->id.value_or(static_cast<unsigned>(index));
     const transport::HostPort& server = parsed->address;
-    dds::add_discovery_server(qos, id, udp_locator(resolve_ipv4(server.host, value), server.port));
+    dds::internal::add_discovery_server(qos, id, udp_locator(resolve_ipv4(server.host, value), server.port));
   }
   if (!options.servers.empty()) {
-    builtin.discovery_config.discoveryProtocol = rsg::dds::DiscoveryProtocol::CLIENT;
+    builtin.discovery_config.discoveryProtocol = rsg::dds::internal::DiscoveryProtocol::CLIENT;
     // Fast DDS's default period delays a gateway's first sample at a reader; 50 ms (with
     // xml_profiles/discovery_server/ on the server) shortens that, with the same traffic once
     // matched (docs/deploying.md).

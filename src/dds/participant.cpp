@@ -57,7 +57,7 @@ Participant::~Participant() {
 
 fdds::Topic* Participant::topic(const std::string& name, fdds::TypeSupport type) {
   if (auto* existing = participant_->find_topic(name, Duration(0, 0))) return existing;
-  announce_no_type_information(type);
+  internal::announce_no_type_information(type);
   if (participant_->register_type(type) != kOk)
     throw EnvironmentError("cannot register type " + type.get_type_name());
   fdds::Topic* created = participant_->create_topic(name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
@@ -69,7 +69,7 @@ fdds::Topic* Participant::robot_state_topic(const std::string& name, const std::
   registerRobotStateTypes();  // the type object the DDS-SQL filter factory looks members up in
   fdds::TypeSupport type(new RobotStatePubSubType());
   if (!type_name.empty()) {
-    dds::rename_type(type, type_name);  // where the filter factory still finds its type object
+    dds::internal::rename_type(type, type_name);  // where the filter factory still finds its type object
   }
   return topic(name, type);
 }

@@ -86,7 +86,7 @@ void load_profiles(const std::filesystem::path& file_or_dir) {
   fastdds_log_to_stderr();
   for (const auto& file : files) {
     check_well_formed(file);
-    if (load_xml_profiles_file(file.string()) != kOk) {
+    if (internal::load_xml_profiles_file(file.string()) != kOk) {
       eprosima::fastdds::dds::Log::Flush();  // its reasons first, then this line
       throw InputError(file.string() +
                        ": Fast DDS rejected this XML profile file (the XMLPARSER lines above say why)");

@@ -99,7 +99,7 @@ fdds::DataReaderQos load_reader_qos(const fdds::Subscriber& subscriber, const st
   fdds::DataReaderQos qos;
   if (subscriber.get_datareader_qos_from_profile(profile, qos) != rsg::dds::kOk)
     throw ViewError("profile '" + profile + "': no such data_reader profile (are the XML profiles loaded?)");
-  read_plain_samples_in_place(qos);
+  internal::read_plain_samples_in_place(qos);
   return qos;
 }
 

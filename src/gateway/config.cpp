@@ -14,7 +14,7 @@
 #include "rsg/dds/ros2.hpp"
 #include "rsg/transport/host_port.hpp"
 #include "rsg/wire/frame.hpp"
-#include "rsg/wire/number.hpp"
+#include "wire/internal/number.hpp"
 
 namespace rsg::gateway {
 namespace {
@@ -416,7 +416,7 @@ std::string known_keys() {
 template <class Number>
 std::string read_number(const YAML::Node& node, Number& out) {
   const std::string& text = node.Scalar();
-  const std::optional<Number> number = wire::parse_number<Number>(text);
+  const std::optional<Number> number = wire::internal::parse_number<Number>(text);
   if (!number) return "'" + text + "' is not " + (std::is_integral_v<Number> ? "an integer" : "a number");
   out = *number;
   return {};
@@ -572,11 +572,11 @@ std::optional<Decimation> parse_decimation(const std::string& value) {
   constexpr std::string_view kEvery = "every:";
   if (value.starts_with(kEvery)) {
     const std::string_view n = std::string_view(value).substr(kEvery.size());
-    const std::optional<std::uint32_t> every = wire::parse_number<std::uint32_t>(n);
+    const std::optional<std::uint32_t> every = wire::internal::parse_number<std::uint32_t>(n);
     if (!every || *every < 1 || *every > 1'000'000) return std::nullopt;
     return Decimation{*every, {}};
   }
-  const std::optional<double> hz = wire::parse_number<double>(value);
+  const std::optional<double> hz = wire::internal::parse_number<double>(value);
   if (!hz || !(*hz > 0 && *hz <= 10000)) return std::nullopt;
   return Decimation{0, std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / *hz))};
 }

@@ -114,7 +114,7 @@ Ingress::Ingress(dds::Participant& participant, Options options)
   if (options_.standard_topics && options_.standard_topics->any())
     standard_topics_.emplace(participant_, *publisher_, *options_.standard_topics);
   // Loans need a plain type; RobotState is one, but a profile could still make writes non-loanable.
-  writer_loans_ = dds::is_plain(*writer_->get_type());
+  writer_loans_ = dds::internal::is_plain(*writer_->get_type());
 }
 
 // The members' owners delete the standard topics' writers (after their thread), the rate writers,

@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "rsg/wire/number.hpp"
+#include "wire/internal/number.hpp"
 
 namespace rsg::gateway {
 namespace {
@@ -92,8 +92,8 @@ bool stderr_is_journal() {
   const std::string_view text(stream);
   const auto colon = text.find(':');
   if (colon == std::string_view::npos) return false;
-  const auto device = wire::parse_number<std::uint64_t>(text.substr(0, colon));
-  const auto inode = wire::parse_number<std::uint64_t>(text.substr(colon + 1));
+  const auto device = wire::internal::parse_number<std::uint64_t>(text.substr(0, colon));
+  const auto inode = wire::internal::parse_number<std::uint64_t>(text.substr(colon + 1));
   struct stat file {};
   if (!device || !inode || ::fstat(STDERR_FILENO, &file) != 0) return false;
   return file.st_dev == *device && file.st_ino == *inode;

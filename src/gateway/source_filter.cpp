@@ -6,7 +6,7 @@
 #include <cstring>
 #include <optional>
 
-#include "rsg/wire/number.hpp"
+#include "wire/internal/number.hpp"
 
 namespace rsg::gateway {
 namespace {
@@ -57,7 +57,7 @@ wire::Parsed<Network> parse_network(std::string_view text) {
 
   unsigned bits = max_bits;
   if (slash != std::string_view::npos) {
-    const std::optional<unsigned> number = wire::parse_number<unsigned>(text.substr(slash + 1));
+    const std::optional<unsigned> number = wire::internal::parse_number<unsigned>(text.substr(slash + 1));
     if (!number || *number > max_bits)
       return wire::ParseFailure{"'" + std::string(text) + "': prefix must be a number 0.." +
                                 std::to_string(max_bits)};

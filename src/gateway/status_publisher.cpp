@@ -21,7 +21,7 @@ StatusPublisher::StatusPublisher(dds::Participant& participant, const std::strin
   publisher_ = dds::own(participant_, participant_.publisher(partitions));
   // TypeSupport takes ownership of the type object it is given.
   fdds::TypeSupport type(new GatewayStatusPubSubType());
-  if (!type_name.empty()) dds::rename_type(type, type_name);
+  if (!type_name.empty()) dds::internal::rename_type(type, type_name);
   fdds::Topic* status_topic = participant_.topic(topic, type);
   writer_ = dds::own(*publisher_, create_writer_with_profile(*publisher_, status_topic, profile),
                      "the GatewayStatus writer with profile '" + profile + "'");

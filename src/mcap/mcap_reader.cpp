@@ -37,7 +37,7 @@ class RecordCursor {
     const std::span<const std::uint8_t> left = bytes_.subspan(static_cast<std::size_t>(offset_));
     if (left.size() < kRecordPrefixBytes) return std::nullopt;
     std::uint64_t length = 0;
-    detail::Cursor prefix(left.subspan(1, 8));
+    internal::Cursor prefix(left.subspan(1, 8));
     prefix.get_int(length);
     if (length > left.size() - kRecordPrefixBytes) return std::nullopt;
     offset_ += kRecordPrefixBytes + length;

@@ -191,7 +191,7 @@ struct DataEnd {
   static constexpr auto fields() { return std::tuple{&DataEnd::data_section_crc}; }
 };
 
-namespace detail {
+namespace internal {
 
 template <typename T>
 constexpr bool kIsPairVector = false;
@@ -317,13 +317,13 @@ class Cursor {
   std::span<const std::uint8_t> bytes_;
 };
 
-}  // namespace detail
+}  // namespace internal
 
 /// The content length of `record` (without opcode and length prefix).
 template <typename Record>
 std::uint64_t content_size(const Record& record) {
   return std::apply(
-      [&](auto... field) { return (std::uint64_t{0} + ... + detail::field_size(record.*field)); },
+      [&](auto... field) { return (std::uint64_t{0} + ... + internal::field_size(record.*field)); },
       Record::fields());
 }
 
@@ -332,8 +332,8 @@ template <typename Record>
 std::uint64_t append_record(std::vector<std::uint8_t>& out, const Record& record) {
   const std::uint64_t size = content_size(record);
   out.push_back(static_cast<std::uint8_t>(Record::opcode));
-  detail::put_int(out, size);
-  std::apply([&](auto... field) { (detail::put_field(out, record.*field), ...); }, Record::fields());
+  internal::put_int(out, size);
+  std::apply([&](auto... field) { (internal::put_field(out, record.*field), ...); }, Record::fields());
   return kRecordPrefixBytes + size;
 }
 
@@ -342,7 +342,7 @@ std::uint64_t append_record(std::vector<std::uint8_t>& out, const Record& record
 template <typename Record>
 std::optional<Record> parse_record(std::span<const std::uint8_t> content) {
   Record record;
-  detail::Cursor cursor(content);
+  internal::Cursor cursor(content);
   const bool complete =
       std::apply([&](auto... field) { return (cursor.get(record.*field) && ...); }, Record::fields());
   if (!complete) return std::nullopt;

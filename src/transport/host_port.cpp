@@ -3,7 +3,7 @@
 #include <optional>
 #include <utility>
 
-#include "rsg/wire/number.hpp"
+#include "wire/internal/number.hpp"
 
 namespace rsg::transport {
 
@@ -18,7 +18,7 @@ wire::Parsed<HostPort> parse_host_port(std::string_view value, HostPortRule rule
   if (colon == 0 && rule != HostPortRule::kBindAddress)
     return wire::ParseFailure{quoted + " is not HOST:PORT"};
   const bool zero_allowed = rule == HostPortRule::kPortMayBeZero || rule == HostPortRule::kBindAddress;
-  const std::optional<unsigned> port = wire::parse_number<unsigned>(value.substr(colon + 1));
+  const std::optional<unsigned> port = wire::internal::parse_number<unsigned>(value.substr(colon + 1));
   if (!port || *port > 65535 || (*port == 0 && !zero_allowed))
     return wire::ParseFailure{quoted + ": port must be a number " + (zero_allowed ? "0" : "1") + "..65535"};
   return HostPort{std::string(value.substr(0, colon)), *port};
@@ -28,7 +28,7 @@ wire::Parsed<DiscoveryServer> parse_discovery_server(std::string_view value) {
   DiscoveryServer server;
   std::string_view host_port = value;
   if (const std::size_t at = value.find('@'); at != std::string_view::npos) {
-    const std::optional<unsigned> given = wire::parse_number<unsigned>(value.substr(0, at));
+    const std::optional<unsigned> given = wire::internal::parse_number<unsigned>(value.substr(0, at));
     if (!given || *given > 255)
       return wire::ParseFailure{"'" + std::string(value) + "': server id before '@' must be 0..255"};
     server.id = *given;

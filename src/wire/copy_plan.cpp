@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace rsg::wire {
+namespace rsg::wire::detail {
 
 CopyPlan::CopyPlan(const Selection& selection, const FieldLayout& layout) noexcept : selection_(selection) {
   std::uint32_t frame_offset = kHeaderBytes;
@@ -80,4 +80,4 @@ ChunkedCopyPlan::ChunkedCopyPlan(const Selection& selection, const FieldLayout& 
   }
 }
 
-}  // namespace rsg::wire
+}  // namespace rsg::wire::detail

@@ -1,4 +1,4 @@
-#include "wire/crc32_copy.hpp"
+#include "wire/internal/crc32_copy.hpp"
 
 #include <immintrin.h>
 
@@ -13,7 +13,12 @@
 // The per-chunk helpers must inline into the loop: as calls they cost more than the copy saves.
 #define RSG_STITCHED_INLINE RSG_STITCHED __attribute__((always_inline)) inline
 
-namespace rsg::wire::detail {
+namespace rsg::wire::internal {
+using detail::ByteMove;
+using detail::ChunkedCopyPlan;
+using detail::ChunkPiece;
+using detail::CopyPlan;
+using detail::kChunkBytes;
 namespace {
 
 // Folding moves the running remainder of the CRC (sixteen bytes per 128-bit lane) D bits further
@@ -440,4 +445,4 @@ std::uint32_t gather_crc32(std::span<std::uint8_t> frame, const ChunkedCopyPlan&
                               : gather_crc32_portable(frame, plan, base);
 }
 
-}  // namespace rsg::wire::detail
+}  // namespace rsg::wire::internal

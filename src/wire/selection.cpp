@@ -3,9 +3,9 @@
 #include <string>
 #include <utility>
 
-#include "rsg/wire/number.hpp"
-#include "rsg/wire/text.hpp"
-#include "wire/group_bytes.hpp"
+#include "wire/internal/group_bytes.hpp"
+#include "wire/internal/number.hpp"
+#include "wire/internal/text.hpp"
 
 namespace rsg::wire {
 namespace {
@@ -17,7 +17,7 @@ std::string for_each_item(std::string_view list, OnItem&& on_item) {
   if (list.empty()) return "empty list";
   while (true) {
     const std::size_t comma = list.find(',');
-    const std::string_view item = trim(list.substr(0, comma));
+    const std::string_view item = internal::trim(list.substr(0, comma));
     if (std::string why = on_item(item); !why.empty()) return why;
     if (comma == std::string_view::npos) return {};
     list.remove_prefix(comma + 1);
@@ -29,7 +29,7 @@ std::string for_each_item(std::string_view list, OnItem&& on_item) {
 std::uint16_t Selection::data_bytes() const {
   std::uint16_t total = 0;
   for (std::size_t group = 0; group < kGroupCount; ++group)
-    total += detail::kSelectedBytes[group][data_select[group]];
+    total += internal::kSelectedBytes[group][data_select[group]];
   return total;
 }
 
@@ -48,7 +48,7 @@ Parsed<Selection> parse_field_list(std::string_view list) {
 Parsed<Selection> parse_group_list(std::string_view list) {
   Selection selection;
   std::string why = for_each_item(list, [&](std::string_view item) -> std::string {
-    const std::optional<unsigned> group = parse_number<unsigned>(item);
+    const std::optional<unsigned> group = internal::parse_number<unsigned>(item);
     if (!group || *group >= kGroupCount) return "'" + std::string(item) + "' is not a group number 0..5";
     selection.add_group(*group);
     return {};

@@ -20,7 +20,6 @@ import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "support"))
 from test_domain import acquire_domain  # noqa: E402  (the domain pool of ctest -j)
 
 

@@ -19,7 +19,6 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parents[0] / "integration"))
 sys.path.insert(0, str(HERE / "readers"))
 from harness import acquire_domain, free_udp_port, read_json  # noqa: E402
 from readers import realtime_prefix, terminate  # noqa: E402

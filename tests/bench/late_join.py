@@ -33,7 +33,6 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "tests" / "integration"))
 from harness import acquire_domain, free_udp_port  # noqa: E402
 from scale import cpu_model  # noqa: E402  (tests/bench, next to this file)
 

@@ -29,7 +29,6 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parents[0] / "integration"))
 sys.path.insert(0, str(HERE / "readers"))
 from harness import acquire_domain, free_udp_port, read_json, wait_for  # noqa: E402
 from metrics_support import free_tcp_port  # noqa: E402

@@ -66,6 +66,9 @@ set -euo pipefail
 SUITES=(wire e2e record scale late_join readers churn dumps metrics ros2_rate)
 
 here=$(cd "$(dirname "$0")" && pwd)
+# The Python benches import tests/support's helpers by name: that folder on PYTHONPATH, as ctest's
+# tests/support/python.py puts it.
+export PYTHONPATH=$here/../support${PYTHONPATH:+:$PYTHONPATH}
 usage() { echo "usage: $0 BUILD_DIR [${SUITES[*]}]" >&2; exit 2; }
 [[ $# -ge 1 ]] || usage
 build=$1

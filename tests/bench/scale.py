@@ -52,16 +52,13 @@ import json
 import os
 import signal
 import subprocess
-import sys
 import tempfile
 import threading
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "net"))
 from netbed import HOSTS, NetBed, discovery_server_argv  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "support"))
 from test_domain import acquire_domain  # noqa: E402
 
 RAW_PORT = 17000

@@ -12,7 +12,7 @@ namespace rsg {
 namespace {
 
 namespace fdds = eprosima::fastdds::dds;
-using rsg::dds::DiscoveryProtocol;
+using rsg::dds::internal::DiscoveryProtocol;
 using rsg::dds::rtps::IPLocator;
 
 dds::DiscoveryOptions servers(std::vector<std::string> values) {
@@ -35,14 +35,14 @@ TEST(Discovery, ServersBecomeClientOfTheIdsFastddsDiscoveryUses) {
   const auto& config = qos.wire_protocol().builtin.discovery_config;
   EXPECT_EQ(config.discoveryProtocol, DiscoveryProtocol::CLIENT);
   ASSERT_EQ(config.m_DiscoveryServers.size(), 3u);
-  const auto locator = rsg::dds::discovery_server_locator(qos, 0);
+  const auto locator = rsg::dds::internal::discovery_server_locator(qos, 0);
   EXPECT_EQ(IPLocator::ip_to_string(locator), "198.18.0.2");
   EXPECT_EQ(locator.port, 11811u);
-  EXPECT_EQ(IPLocator::ip_to_string(rsg::dds::discovery_server_locator(qos, 2)), "198.18.0.4");
+  EXPECT_EQ(IPLocator::ip_to_string(rsg::dds::internal::discovery_server_locator(qos, 2)), "198.18.0.4");
   if (RSG_FASTDDS_MAJOR >= 3) return;
-  EXPECT_EQ(rsg::dds::discovery_server_prefix(qos, 0), "44.53.00.5f.45.50.52.4f.53.49.4d.41");
-  EXPECT_EQ(rsg::dds::discovery_server_prefix(qos, 1), "44.53.01.5f.45.50.52.4f.53.49.4d.41");
-  EXPECT_EQ(rsg::dds::discovery_server_prefix(qos, 2), "44.53.07.5f.45.50.52.4f.53.49.4d.41");
+  EXPECT_EQ(rsg::dds::internal::discovery_server_prefix(qos, 0), "44.53.00.5f.45.50.52.4f.53.49.4d.41");
+  EXPECT_EQ(rsg::dds::internal::discovery_server_prefix(qos, 1), "44.53.01.5f.45.50.52.4f.53.49.4d.41");
+  EXPECT_EQ(rsg::dds::internal::discovery_server_prefix(qos, 2), "44.53.07.5f.45.50.52.4f.53.49.4d.41");
 }
 
 TEST(Discovery, TheXmlExampleIsTheSameClient) {
@@ -54,7 +54,7 @@ TEST(Discovery, TheXmlExampleIsTheSameClient) {
   fdds::DomainParticipantQos from_flag;
   dds::apply_discovery(servers({"127.0.0.1:11811"}), 0, from_flag);
   EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.discoveryProtocol,
-            dds::DiscoveryProtocol::CLIENT);
+            dds::internal::DiscoveryProtocol::CLIENT);
   EXPECT_EQ(from_xml.wire_protocol().builtin.discovery_config.m_DiscoveryServers,
             from_flag.wire_protocol().builtin.discovery_config.m_DiscoveryServers);
   // Both run the discovery cycle every 50 ms, not Fast DDS's 450 (docs/scaling.md).

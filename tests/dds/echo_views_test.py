@@ -14,9 +14,7 @@ import subprocess
 import sys
 import tempfile
 import unittest
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import free_udp_port, test_domain, wait_for_stats  # noqa: E402
 
 ARGS = None

@@ -20,8 +20,8 @@ std::vector<std::uint8_t> serialized(std::uint8_t group_select) {
   sample.group_select(group_select);
   for (std::size_t g = 0; g < 6; ++g) sample.group_present()[g] = ((group_select >> g) & 1U) != 0;
   RobotStatePubSubType type;
-  dds::rtps::SerializedPayload_t payload(dds::max_serialized_size(type));
-  EXPECT_TRUE(dds::serialize(type, &sample, payload));
+  dds::rtps::SerializedPayload_t payload(dds::internal::max_serialized_size(type));
+  EXPECT_TRUE(dds::internal::serialize(type, &sample, payload));
   return {payload.data, payload.data + payload.length};
 }
 

@@ -62,7 +62,7 @@ TEST(HotPath, DecodeIntoASampleAllocatesNothing) {
 void expect_no_allocations_while_publishing(const std::string& profile, bool reader_data_sharing) {
   // A reader in a second participant and no intra-process shortcut, so the measured writes really
   // reach another participant through a transport or data-sharing.
-  rsg::dds::disable_intraprocess_delivery();
+  rsg::dds::internal::disable_intraprocess_delivery();
   const int domain = rsg::test::test_domain();
   dds::load_profiles(std::filesystem::path(RSG_TEST_DATA_DIR) / "hot_path_profiles.xml");
   dds::Participant publishing(domain, profile);

@@ -15,9 +15,9 @@ namespace {
 
 TEST(RobotStateType, IsPlainBoundedAndUnkeyed) {
   RobotStatePubSubType type;
-  EXPECT_TRUE(rsg::dds::is_plain(type));
+  EXPECT_TRUE(rsg::dds::internal::is_plain(type));
   EXPECT_TRUE(type.is_bounded());
-  EXPECT_FALSE(rsg::dds::is_keyed(type));
+  EXPECT_FALSE(rsg::dds::internal::is_keyed(type));
 }
 
 TEST(RobotStateType, MembersDoNotOverlap) {

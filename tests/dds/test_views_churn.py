@@ -25,12 +25,9 @@ import threading
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "ros2"))
 from harness import (check, free_udp_port, main, read_json, read_json_lines, realtime_prefix, wait_for,  # noqa: E402
                      wait_for_stats)
-from rclpy_common import RosEnv, read_messages, start_peer, wait_peer_matched  # noqa: E402
-from test_rclpy_state import check_in_order  # noqa: E402
+from rclpy_common import RosEnv, check_in_order, read_messages, start_peer, wait_peer_matched  # noqa: E402
 
 CHURN_S = 40
 FINAL_COUNT = 2000

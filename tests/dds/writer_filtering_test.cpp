@@ -58,7 +58,7 @@ enum class WriterKnowsGroupFilter { kNo, kYes };
 
 Outcome publish_mixed_stream_to_a_view(const fdds::DataWriterQos& base_writer_qos, Delivery delivery,
                                        WriterKnowsGroupFilter knows = WriterKnowsGroupFilter::kYes) {
-  dds::disable_intraprocess_delivery();
+  dds::internal::disable_intraprocess_delivery();
   dds::load_profiles(dds::default_profiles_dir());
   const int domain = rsg::test::test_domain();
 
@@ -154,7 +154,7 @@ TEST(WriterSideFiltering, AWriterWithoutTheGroupFilterClassSendsEverything) {
 // The QoS the gateway really publishes with (xml_profiles/gateway.xml, then
 // leave_filtering_to_readers): no filter runs in the writer, the view's reader filters.
 TEST(WriterSideFiltering, TheGatewayWriterLeavesFilteringToTheReaders) {
-  dds::disable_intraprocess_delivery();  // before `any`: Fast DDS 3 ignores it after a participant
+  dds::internal::disable_intraprocess_delivery();  // before `any`: Fast DDS 3 ignores it after a participant
   dds::load_profiles(dds::default_profiles_dir());
   dds::Participant any(rsg::test::test_domain(), "");
   fdds::DataWriterQos gateway_qos;

@@ -9,7 +9,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import TestFailure, check, main  # noqa: E402
 
 RULES = Path(__file__).resolve().parents[2] / "deploy" / "prometheus"

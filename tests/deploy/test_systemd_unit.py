@@ -11,7 +11,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import TestFailure, check, free_udp_port, main, wait_for_stats  # noqa: E402
 
 DEPLOY = Path(__file__).resolve().parents[2] / "deploy" / "systemd"

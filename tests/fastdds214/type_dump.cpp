@@ -34,12 +34,12 @@ void fill(T& value, double seed) {
 }
 
 void dump(fdds::TopicDataType& type, const void* sample) {
-  rsg::dds::rtps::SerializedPayload_t payload(rsg::dds::max_serialized_size(type));
-  if (!rsg::dds::serialize(type, sample, payload)) {
+  rsg::dds::rtps::SerializedPayload_t payload(rsg::dds::internal::max_serialized_size(type));
+  if (!rsg::dds::internal::serialize(type, sample, payload)) {
     std::printf("%s serialize failed\n", type.getName());
     return;
   }
-  std::printf("%s max=%u bytes=", type.getName(), rsg::dds::max_serialized_size(type));
+  std::printf("%s max=%u bytes=", type.getName(), rsg::dds::internal::max_serialized_size(type));
   for (std::uint32_t i = 0; i < payload.length; ++i) std::printf("%02x", payload.data[i]);
   std::printf("\n");
 }

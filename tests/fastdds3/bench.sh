@@ -13,6 +13,9 @@
 # The RSG_BENCH_E2E_* durations of tests/bench/run_bench.sh apply to both runs.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+# The Python benches import tests/support's helpers by name: that folder on PYTHONPATH, as ctest's
+# tests/support/python.py puts it.
+export PYTHONPATH=$PWD/tests/support${PYTHONPATH:+:$PYTHONPATH}
 host_build=${1:-build}
 shift || true
 suites=("${@:-e2e readers}")

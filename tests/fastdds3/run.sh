@@ -15,6 +15,9 @@
 # Closes with one line "test-fastdds3: N passed, N failed".
 set -uo pipefail
 cd "$(dirname "$0")/../.."
+# The Python tests import tests/support's helpers by name: that folder on PYTHONPATH, as ctest's
+# tests/support/python.py puts it.
+export PYTHONPATH=$PWD/tests/support${PYTHONPATH:+:$PYTHONPATH}
 checkout=$PWD
 host_build=${1:-build}
 build=${RSG_FASTDDS3_BUILD:-build-fdds3}

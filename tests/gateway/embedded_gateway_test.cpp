@@ -59,7 +59,7 @@ class EmbeddedGatewayTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     // The reader must get its samples over the network, as a reader in another process would.
-    rsg::dds::disable_intraprocess_delivery();
+    rsg::dds::internal::disable_intraprocess_delivery();
   }
   const int domain_ = rsg::test::test_domain();
 };

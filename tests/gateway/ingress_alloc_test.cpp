@@ -93,7 +93,7 @@ class IngressAllocation : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     // No intra-process shortcut: the writes must really reach the other participant.
-    dds::disable_intraprocess_delivery();
+    dds::internal::disable_intraprocess_delivery();
     dds::load_profiles(std::filesystem::path(RSG_PROFILES_DIR) / "gateway.xml");
     // UDP only: Fast DDS 2.9's SHM transport allocates per send, which would hide rsg's own.
     dds::load_profiles(std::filesystem::path(RSG_TEST_DATA_DIR) / "hot_path_profiles.xml");

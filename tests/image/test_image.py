@@ -48,7 +48,6 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "integration"))
 sys.path.insert(0, str(ROOT / "tests" / "support"))
 from harness import (TestFailure, check, free_udp_port, read_json_lines, wait_for, wait_for_stats,  # noqa: E402
                      wait_reader_matched)

@@ -16,9 +16,7 @@ import sys
 import tempfile
 import time
 import unittest
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "support"))
 from test_domain import test_domain  # noqa: E402  (a DDS domain this test alone holds)
 
 ARGS = None

@@ -21,7 +21,6 @@ from pathlib import Path
 
 from netbed import HOSTS, LineDigests, NetBed, discovery_server_argv, missing_runs
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "integration"))
 from harness import DEFAULT_WAIT_S, check, main, read_json, wait_for, wait_for_stats, wait_matched  # noqa: E402
 
 SCENARIO = sys.argv.pop(1) if len(sys.argv) > 1 and not sys.argv[1].startswith("-") else "stream"

@@ -17,8 +17,23 @@ installed=$(cd "$work/prefix/include/rsg" && find . -name '*.hpp' | sort)
 for header in $installed; do
   case "$header" in ./error.hpp | ./wire/* | ./transport/* | ./dds/* | ./idl/* | ./gateway/embedded_gateway.hpp) ;; *) echo "FAIL: internal header installed: $header"; exit 1 ;; esac
 done
-# No installed header reaches for what is not installed (src/<layer>/internal/, CONTRIBUTING.md).
-if grep -rn '#include "[a-z]*/internal/' "$work/prefix/include"; then echo "FAIL: an installed header includes an internal one"; exit 1; fi
+# No installed header reaches for what is not installed: rsg's own headers include each other as
+# "rsg/...", never a header of src/ (src/<layer>/internal/ or any other, CONTRIBUTING.md), and name
+# no internal namespace but to befriend (wire::internal::FrameDecoder, which stays in src/wire).
+if grep -rn '#include "' "$work/prefix/include/rsg" --include='*.hpp' --exclude-dir=idl | grep -v '#include "rsg/'; then
+  echo "FAIL: an installed header includes one that is not installed"; exit 1
+fi
+if grep -rn 'internal::' "$work/prefix/include/rsg" --include='*.hpp' --exclude-dir=idl | grep -v 'friend class internal::'; then
+  echo "FAIL: an installed header uses an internal name"; exit 1
+fi
+# The package exports what a consumer links and nothing internal (CONTRIBUTING.md, "Layers"): the
+# gateway's internals travel inside rsg::embedded_gateway's archive, the generated types inside rsg::dds's.
+exported=$(cat "$work"/prefix/lib*/cmake/rsg/rsg*Targets.cmake | sed -n 's/^add_library(\(rsg::[a-z_]*\) .*/\1/p' | sort | tr '\n' ' ')
+[[ "$exported" == "rsg::dds rsg::eigen rsg::embedded_gateway rsg::transport rsg::wire " ]] ||
+  { echo "FAIL: the package exports $exported"; exit 1; }
+archives=$(cd "$work"/prefix/lib* && ls *.a | sort | tr '\n' ' ')
+[[ "$archives" == "librsg_dds.a librsg_embedded_gateway.a librsg_transport.a librsg_wire.a " ]] ||
+  { echo "FAIL: the archives installed are $archives"; exit 1; }
 for tool in rsg_gateway rsg_sim rsg_echo rsg_frame rsg_record rsg_replay rsg_view; do
   [[ -x "$work/prefix/bin/$tool" ]] || { echo "FAIL: $tool not installed"; exit 1; }
 done

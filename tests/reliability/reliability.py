@@ -12,8 +12,6 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "integration"))
-
 from harness import (TestFailure, check, free_udp_port, main, read_json, read_json_lines,  # noqa: E402,F401
                      wait_for, wait_for_stats)
 

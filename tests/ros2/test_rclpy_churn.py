@@ -14,12 +14,9 @@ import signal
 import sys
 import threading
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, free_udp_port, main, read_json, read_json_lines, wait_for, wait_for_stats  # noqa: E402
-from rclpy_common import RosEnv, read_messages, start_peer, wait_peer_matched  # noqa: E402
-from test_rclpy_state import check_in_order  # noqa: E402
+from rclpy_common import RosEnv, check_in_order, read_messages, start_peer, wait_peer_matched  # noqa: E402
 
 COUNT = 3000
 RATE = "200"

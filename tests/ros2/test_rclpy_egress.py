@@ -9,7 +9,6 @@ import json
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, main  # noqa: E402
 from rclpy_common import RosEnv, group_present, hash_hint, start_peer  # noqa: E402
 from test_ros2_egress import check_egress, command_records, egress_gateway, encode  # noqa: E402

@@ -14,9 +14,7 @@ RIHS01 type hash of that type.
 import json
 import sys
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, free_udp_port, main, read_json_lines, wait_for_stats  # noqa: E402
 from rclpy_common import RosEnv, hash_hint, read_messages, start_peer, wait_peer_matched  # noqa: E402
 from test_ros2_standard import check_rotation, check_stamps, in_order, roughly  # noqa: E402

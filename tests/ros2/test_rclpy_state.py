@@ -17,32 +17,13 @@ In the root namespace and in /robot1, fed by rsg_sim:
 """
 import json
 import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, free_udp_port, main, read_json_lines, wait_for_stats  # noqa: E402
-from rclpy_common import (RosEnv, expected_message, hash_hint, read_messages, same_message,  # noqa: E402
-                          start_peer, wait_peer_matched)
+from rclpy_common import RosEnv, check_in_order, hash_hint, read_messages, start_peer, wait_peer_matched
 
 COUNT = 200
 RATE = "200"
 FILTER = "group_present[2] = TRUE AND group_present[3] = TRUE"
-
-
-def check_in_order(label, sent, got, member_order):
-    """Every message equals a sent frame, in the order sent; returns the positions matched."""
-    expected = [expected_message(frame, member_order) for frame in sent]
-    positions, position = [], 0
-    for index, message in enumerate(got):
-        while position < len(expected) and same_message(expected[position], message):
-            position += 1
-        if position == len(expected):
-            closest = min(expected, key=lambda e: abs(e["packet_number"] - message["packet_number"]))
-            check(False, f"{label}: message {index} is no frame sent after the previous one: "
-                         f"{same_message(closest, message)}")
-        positions.append(position)
-        position += 1
-    return positions
 
 
 def run(h, env, namespace):

@@ -12,7 +12,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, free_udp_port, main, wait_for_stats  # noqa: E402
 
 COUNT = 20

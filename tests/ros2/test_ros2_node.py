@@ -15,10 +15,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, free_udp_port, main, wait_for  # noqa: E402
-from rclpy_common import REPO, RosEnv, read_messages, start_peer, wait_peer_matched  # noqa: E402
-from test_rclpy_state import check_in_order  # noqa: E402
+from rclpy_common import REPO, RosEnv, check_in_order, read_messages, start_peer, wait_peer_matched  # noqa: E402
 
 COUNT = 2000
 TOPIC = "/controller/robot_state"

@@ -23,7 +23,6 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, free_udp_port, main, read_json, read_json_lines, wait_for, wait_for_stats  # noqa: E402
 
 FRAMES = 2000  # 2 s at 1 kHz

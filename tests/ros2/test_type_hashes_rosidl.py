@@ -15,7 +15,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import check, main  # noqa: E402
 from rclpy_common import REPO, RosEnv  # noqa: E402
 

@@ -30,7 +30,6 @@ import time
 import unittest
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "support"))
 from test_domain import acquire_domain  # noqa: E402
 
 ARGS = None  # the command line, set once by main()

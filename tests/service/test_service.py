@@ -58,7 +58,6 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "tests" / "integration"))
 sys.path.insert(0, str(ROOT / "tests" / "support"))
 from harness import TestFailure, check, free_udp_port, read_json_lines, wait_for  # noqa: E402
 from metrics_support import http_get, parse_samples, value_of  # noqa: E402

@@ -20,7 +20,7 @@
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/state_values.hpp"
 #include "tests/support/random_state.hpp"
-#include "wire/crc32_copy.hpp"
+#include "wire/internal/crc32_copy.hpp"
 
 namespace rsg {
 namespace {
@@ -76,7 +76,7 @@ void fill_random(std::span<std::byte> bytes, std::mt19937_64& rng) {
 class StitchedKernel : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!wire::detail::has_stitched_crc32()) GTEST_SKIP() << "no AVX-512 VPCLMULQDQ on this CPU";
+    if (!wire::internal::has_stitched_crc32()) GTEST_SKIP() << "no AVX-512 VPCLMULQDQ on this CPU";
   }
 };
 
@@ -100,7 +100,7 @@ class KernelCase {
     expected_.assign(destination_.data() - kMargin, destination_.data() + destination_.size() + kMargin);
   }
 
-  const wire::ChunkedCopyPlan& plan() const { return plan_; }
+  const wire::detail::ChunkedCopyPlan& plan() const { return plan_; }
   std::span<std::uint8_t> frame() { return frame_; }
   std::byte* struct_base() { return struct_.data(); }
   /// The destination as the plain path sees it: inside the copy.
@@ -121,7 +121,7 @@ class KernelCase {
   wire::Selection selection_;
   std::size_t struct_size_ = 0;
   wire::FieldLayout layout_;
-  wire::ChunkedCopyPlan plan_;
+  wire::detail::ChunkedCopyPlan plan_;
   std::span<std::uint8_t> frame_;
   std::span<std::byte> struct_;
   std::span<std::byte> destination_;
@@ -134,9 +134,9 @@ TEST_F(StitchedKernel, ScatterMatchesIsalAndMemcpy) {
   for (int round = 0; round < 20'000; ++round) {
     KernelCase input(rng, arena, /*struct_is_destination=*/true);
     const std::uint32_t expected =
-        wire::detail::crc32_scatter_portable(input.frame(), input.plan(), input.expected_struct());
+        wire::internal::crc32_scatter_portable(input.frame(), input.plan(), input.expected_struct());
     const std::uint32_t actual =
-        wire::detail::crc32_scatter_stitched(input.frame(), input.plan(), input.struct_base());
+        wire::internal::crc32_scatter_stitched(input.frame(), input.plan(), input.struct_base());
     ASSERT_EQ(actual, wire::crc32(input.frame())) << "round " << round;
     ASSERT_EQ(actual, expected);
     ASSERT_TRUE(input.same_as_expected()) << "round " << round;
@@ -149,9 +149,9 @@ TEST_F(StitchedKernel, GatherMatchesMemcpyAndIsal) {
   for (int round = 0; round < 20'000; ++round) {
     KernelCase input(rng, arena, /*struct_is_destination=*/false);
     const std::uint32_t expected =
-        wire::detail::gather_crc32_portable(input.expected_frame(), input.plan(), input.struct_base());
+        wire::internal::gather_crc32_portable(input.expected_frame(), input.plan(), input.struct_base());
     const std::uint32_t actual =
-        wire::detail::gather_crc32_stitched(input.frame(), input.plan(), input.struct_base());
+        wire::internal::gather_crc32_stitched(input.frame(), input.plan(), input.struct_base());
     ASSERT_EQ(actual, expected) << "round " << round;
     ASSERT_EQ(actual, wire::crc32(input.frame()));
     ASSERT_TRUE(input.same_as_expected()) << "round " << round;
@@ -168,7 +168,7 @@ TEST_F(StitchedKernel, EveryHeadPaddingASelectionCanHave) {
   std::set<std::size_t> paddings;
   for (int round = 0; round < 200'000; ++round) {
     const wire::Selection selection = random_selection(rng);
-    const wire::ChunkedCopyPlan plan(selection, wire::StateValues::layout());
+    const wire::detail::ChunkedCopyPlan plan(selection, wire::StateValues::layout());
     const std::size_t size = plan.plan().covered_bytes();
     if (size < 256 || !paddings.insert(plan.head_padding()).second) continue;
 
@@ -176,10 +176,11 @@ TEST_F(StitchedKernel, EveryHeadPaddingASelectionCanHave) {
     for (std::uint8_t& byte : covered) byte = static_cast<std::uint8_t>(rng());
     wire::StateValues expected;
     wire::StateValues actual;
-    EXPECT_EQ(wire::detail::crc32_scatter_stitched(covered, plan, static_cast<std::byte*>(actual.storage())),
-              wire::crc32(covered))
+    EXPECT_EQ(
+        wire::internal::crc32_scatter_stitched(covered, plan, static_cast<std::byte*>(actual.storage())),
+        wire::crc32(covered))
         << "padding " << plan.head_padding();
-    wire::detail::copy_to_struct(covered, plan.plan(), static_cast<std::byte*>(expected.storage()));
+    wire::internal::copy_to_struct(covered, plan.plan(), static_cast<std::byte*>(expected.storage()));
     EXPECT_EQ(std::memcmp(actual.storage(), expected.storage(), wire::StateValues::storage_size()), 0)
         << "padding " << plan.head_padding();
   }
@@ -188,7 +189,7 @@ TEST_F(StitchedKernel, EveryHeadPaddingASelectionCanHave) {
 }
 
 TEST(CopyPlan, FullSelectionIsAFewMovesAndLeavesOnlyErrorSetHighBytes) {
-  const wire::CopyPlan plan(wire::Selection::all(), wire::StateValues::layout());
+  const wire::detail::CopyPlan plan(wire::Selection::all(), wire::StateValues::layout());
   // StateValues stores fields in table order; the two 5-byte error sets widen to 8 bytes, which
   // shifts what follows each: the doubles with current_errors, last_motion_errors, the rest.
   EXPECT_EQ(plan.moves().size(), 3U);
@@ -196,12 +197,12 @@ TEST(CopyPlan, FullSelectionIsAFewMovesAndLeavesOnlyErrorSetHighBytes) {
   EXPECT_EQ(plan.fills()[0].size, 3U);
   EXPECT_EQ(plan.fills()[1].size, 3U);
   EXPECT_EQ(plan.covered_bytes(), wire::kHeaderBytes + wire::kMaxDataBytes);
-  const wire::ChunkedCopyPlan chunked(wire::Selection::all(), wire::StateValues::layout());
-  EXPECT_EQ((plan.covered_bytes() + chunked.head_padding()) % wire::kChunkBytes, 0U);
+  const wire::detail::ChunkedCopyPlan chunked(wire::Selection::all(), wire::StateValues::layout());
+  EXPECT_EQ((plan.covered_bytes() + chunked.head_padding()) % wire::detail::kChunkBytes, 0U);
 }
 
 TEST(CopyPlan, EmptySelectionZeroesEverything) {
-  const wire::CopyPlan plan(wire::Selection{}, wire::StateValues::layout());
+  const wire::detail::CopyPlan plan(wire::Selection{}, wire::StateValues::layout());
   EXPECT_TRUE(plan.moves().empty());
   ASSERT_EQ(plan.fills().size(), 1U);
   EXPECT_EQ(plan.fills()[0].size, wire::StateValues::storage_size());

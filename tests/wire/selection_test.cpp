@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "rsg/wire/frame.hpp"
-#include "rsg/wire/text.hpp"
+#include "wire/internal/text.hpp"
 
 namespace rsg {
 namespace {
@@ -57,9 +57,9 @@ TEST(Selection, ListItemsAreTrimmedOfAnyWhiteSpace) {
   const wire::Parsed<wire::Selection> fields = wire::parse_field_list(" q,\tdq\r\n");
   ASSERT_TRUE(fields) << fields.error();
   EXPECT_EQ(*fields, *wire::parse_field_list("q,dq"));
-  EXPECT_EQ(wire::trim(" \t x y \r\n\v\f"), "x y");
-  EXPECT_EQ(wire::trim(" \t "), "");
-  EXPECT_EQ(wire::trim(""), "");
+  EXPECT_EQ(wire::internal::trim(" \t x y \r\n\v\f"), "x y");
+  EXPECT_EQ(wire::internal::trim(" \t "), "");
+  EXPECT_EQ(wire::internal::trim(""), "");
 }
 
 TEST(SelectionRequest, RoundTripsAndIsRejectedByTheStateDecoder) {

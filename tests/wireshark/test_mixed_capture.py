@@ -11,9 +11,7 @@ import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 from harness import TestFailure, check, main, wait_for, wait_for_stats, wait_reader_matched, free_udp_port  # noqa: E402
 
 import tshark_run  # noqa: E402

@@ -37,8 +37,8 @@ class DecodeResult;
 /// Validates a frame in the spec's order and reports the first failure.
 DecodeResult decode(std::span<const std::uint8_t> bytes) noexcept;
 
-namespace detail {
-class FrameDecoder;  // the validation behind `decode` and `FrameCodec::decode`
+namespace internal {
+class FrameDecoder;  // the validation behind `decode` and `FrameCodec::decode`: never installed (src/wire/)
 }
 
 /// A frame that passed every check of the spec. Refers to the caller's bytes, which must outlive it.
@@ -53,7 +53,7 @@ class FrameView {
   std::span<const std::uint8_t> bytes() const { return bytes_; }
 
  private:
-  friend class detail::FrameDecoder;
+  friend class internal::FrameDecoder;
 
   std::span<const std::uint8_t> bytes_;
   FrameHeader header_;
@@ -68,7 +68,7 @@ class DecodeResult {
   const FrameError& error() const { return error_; }
 
  private:
-  friend class detail::FrameDecoder;
+  friend class internal::FrameDecoder;
   FrameView frame_;
   FrameError error_;
 };

@@ -5,7 +5,7 @@
 //   if (!result) { count(result.error().category()); return; }   // `sample` holds garbage: drop it
 //
 // The same checks and results as `decode` followed by `copy_fields`, and `encode`, but the copy
-// and the CRC happen in the same pass over the bytes (see src/wire/crc32_copy.hpp), which costs
+// and the CRC happen in the same pass over the bytes (see src/wire/internal/crc32_copy.hpp), which costs
 // much less than two passes (measured in docs/benchmarks/wire.md). The codec keeps the copy plan
 // of the last selection it saw.
 #pragma once
@@ -34,11 +34,11 @@ class FrameCodec {
                       std::span<std::uint8_t> out) noexcept;
 
  private:
-  const ChunkedCopyPlan& plan_for(const Selection& selection, std::uint64_t key) noexcept;
+  const detail::ChunkedCopyPlan& plan_for(const Selection& selection, std::uint64_t key) noexcept;
   void replan(const Selection& selection, std::uint64_t key) noexcept;
 
   const FieldLayout* layout_;
-  ChunkedCopyPlan plan_;
+  detail::ChunkedCopyPlan plan_;
   std::uint64_t plan_key_;  // plan_'s selection as 7 header bytes
 };
 

@@ -13,10 +13,10 @@
 // servers) is named here once, and the rest of the tree uses these names:
 //
 //   rsg::dds::kOk, kBadParameter, Duration, kInfinite, rtps, succeeded   (rsg/dds/fastdds.hpp)
-//   rsg::dds::serialize, deserialize, max_serialized_size, is_plain, rename_type
-//   rsg::dds::is_keyed, disable_intraprocess_delivery, read_plain_samples_in_place
-//   rsg::dds::load_xml_profiles_file
-//   rsg::dds::add_discovery_server, discovery_server_locator, discovery_server_prefix
+//   rsg::dds::internal::serialize, deserialize, max_serialized_size, is_plain, rename_type
+//   rsg::dds::internal::is_keyed, disable_intraprocess_delivery, read_plain_samples_in_place
+//   rsg::dds::internal::load_xml_profiles_file, DiscoveryProtocol
+//   rsg::dds::internal::add_discovery_server, discovery_server_locator, discovery_server_prefix
 //
 // fastddsgen 4 names its files .hpp and registers TypeObjects by itself: src/dds/CMakeLists.txt puts
 // forwarding headers with fastddsgen 2's names next to its output (RobotState.h, ...PubSubTypes.h,
@@ -63,13 +63,11 @@
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 #endif
 
-namespace rsg::dds {
+namespace rsg::dds::internal {
 
 #if RSG_FASTDDS_MAJOR >= 3
 
 using DiscoveryProtocol = rtps::DiscoveryProtocol;
-
-namespace detail {
 
 /// `original` under another name, announcing no TypeInformation: see rename_type().
 class RenamedType final : public eprosima::fastdds::dds::TopicDataType {
@@ -129,8 +127,6 @@ class RenamedType final : public eprosima::fastdds::dds::TopicDataType {
   eprosima::fastdds::dds::TypeSupport original_;
 };
 
-}  // namespace detail
-
 /// Gives `type` another registered name (the ROS 2 mangled name, a user's --type-name), under which
 /// its endpoints match by type name alone, as on Fast DDS 2: they announce no TypeInformation. The
 /// name belongs to a type defined elsewhere (rosidl's rsg_msgs/msg/RobotState) whose TypeObject
@@ -139,7 +135,7 @@ class RenamedType final : public eprosima::fastdds::dds::TopicDataType {
 /// subscription would never match. The samples are the same bytes, and DDS-SQL filters on the new
 /// name read the original's members.
 inline void rename_type(eprosima::fastdds::dds::TypeSupport& type, const std::string& name) {
-  type = eprosima::fastdds::dds::TypeSupport(new detail::RenamedType(std::move(type), name));
+  type = eprosima::fastdds::dds::TypeSupport(new RenamedType(std::move(type), name));
 }
 
 /// Loads an XML profile file written for Fast DDS 2 (rsg's xml_profiles/) or 3. Fast DDS 3 renamed
@@ -342,4 +338,4 @@ inline void add_discovery_server(eprosima::fastdds::dds::DomainParticipantQos& q
 
 #endif
 
-}  // namespace rsg::dds
+}  // namespace rsg::dds::internal

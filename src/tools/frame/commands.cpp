@@ -16,7 +16,7 @@
 #include "rsg/wire/hex.hpp"
 #include "rsg/wire/json.hpp"
 #include "rsg/wire/state_values.hpp"
-#include "rsg/wire/text.hpp"
+#include "wire/internal/text.hpp"
 
 namespace rsg::tools::frame {
 namespace {
@@ -31,7 +31,7 @@ void for_each_nonblank_line(std::istream& in, OnLine&& on_line) {
   std::size_t number = 0;
   for (std::string line; std::getline(in, line);) {
     ++number;
-    const std::string_view text = wire::trim(line);
+    const std::string_view text = wire::internal::trim(line);
     if (!text.empty() && !on_line(number, text)) return;
   }
 }

@@ -1,7 +1,7 @@
 #include "tools/sim/schedule.hpp"
 
-#include "rsg/wire/number.hpp"
-#include "rsg/wire/text.hpp"
+#include "wire/internal/number.hpp"
+#include "wire/internal/text.hpp"
 
 namespace rsg::tools::sim {
 namespace {
@@ -15,7 +15,7 @@ wire::Parsed<wire::Selection> parse_item(std::string_view item) {
   }
   // No field name starts with "g" followed by a digit, so group tokens cannot shadow a field.
   if (item.size() >= 2 && item.front() == 'g') {
-    if (const std::optional<unsigned> group = wire::parse_number<unsigned>(item.substr(1));
+    if (const std::optional<unsigned> group = wire::internal::parse_number<unsigned>(item.substr(1));
         group && *group < wire::kGroupCount) {
       selection.add_group(*group);
       return selection;
@@ -32,7 +32,7 @@ wire::Parsed<wire::Selection> parse_selection_items(std::string_view list) {
   wire::Selection selection;
   while (true) {
     const std::size_t comma = list.find(',');
-    const std::string_view item = wire::trim(list.substr(0, comma));
+    const std::string_view item = wire::internal::trim(list.substr(0, comma));
     if (item.empty()) return wire::ParseFailure{"empty item in '" + whole + "'"};
     const wire::Parsed<wire::Selection> parsed = parse_item(item);
     if (!parsed) return parsed;
@@ -45,8 +45,8 @@ wire::Parsed<wire::Selection> parse_selection_items(std::string_view list) {
 wire::Parsed<Schedule::Entry> parse_schedule_entry(std::string_view spec) {
   const std::size_t colon = spec.find(':');
   if (colon == std::string_view::npos) return wire::ParseFailure{"'" + std::string(spec) + "' is not N:LIST"};
-  const std::string_view period_text = wire::trim(spec.substr(0, colon));
-  const std::uint64_t period = wire::parse_number<std::uint64_t>(period_text).value_or(0);
+  const std::string_view period_text = wire::internal::trim(spec.substr(0, colon));
+  const std::uint64_t period = wire::internal::parse_number<std::uint64_t>(period_text).value_or(0);
   if (period == 0)
     return wire::ParseFailure{"'" + std::string(period_text) + "' in '" + std::string(spec) +
                               "' is not a period N >= 1"};

@@ -23,7 +23,6 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "net"))
 from netbed import NetBed  # noqa: E402
 from scale import SERIES, Point, fit_slope  # noqa: E402
 

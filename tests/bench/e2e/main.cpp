@@ -230,7 +230,7 @@ int main(int argc, char** argv) {
   ::prctl(PR_SET_TIMERSLACK, 1UL);
   // A reader in this process must get its samples over a transport, as one in another process
   // would (embedded_callback reads the embedded gateway's writer from here).
-  rsg::dds::disable_intraprocess_delivery();
+  rsg::dds::internal::disable_intraprocess_delivery();
 
   if (role == "relay") {
     try {

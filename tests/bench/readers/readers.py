@@ -30,14 +30,11 @@ import json
 import os
 import signal
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parents[1] / "integration"))
-sys.path.insert(0, str(HERE.parents[1] / "ros2"))
 from harness import acquire_domain, free_udp_port, read_json, realtime_prefix, wait_for  # noqa: E402
 from test_domain import release_domain  # noqa: E402  (tests/support, on the path through harness)
 

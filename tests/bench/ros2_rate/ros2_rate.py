@@ -28,8 +28,6 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parents[1] / "integration"))
-sys.path.insert(0, str(HERE.parents[1] / "ros2"))
 from harness import acquire_domain, free_udp_port, read_json, wait_for  # noqa: E402
 from rclpy_common import RosEnv  # noqa: E402
 from test_domain import release_domain  # noqa: E402  (tests/support, on the path through harness)

@@ -44,7 +44,6 @@ if Path(sys.prefix).resolve() != (DEPS / "mcap").resolve():
         sys.exit(1)
     os.execv(str(VENV_PYTHON), [str(VENV_PYTHON), __file__, "--case", CASE, "--deps", str(DEPS), *sys.argv[1:]])
 
-sys.path.insert(0, str(ROOT / "tests" / "integration"))
 from harness import check, free_udp_port, main, read_json_lines, wait_for, wait_for_stats, wait_matched  # noqa: E402
 from replay_target import second_gateway_with_echo  # noqa: E402
 

@@ -17,7 +17,6 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[2]
-sys.path.insert(0, str(ROOT / "tests" / "integration"))
 from harness import (UdpRelay, check, free_udp_port, main, read_json_lines, receive_timed,  # noqa: E402
                      timed_receiver, wait_for, wait_for_stats, wait_matched)
 from replay_target import second_gateway_with_echo  # noqa: E402

@@ -18,7 +18,6 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[2]
-sys.path.insert(0, str(ROOT / "tests" / "integration"))
 from harness import check, free_udp_port, main, read_json_lines, wait_for, wait_for_stats, wait_reader_matched  # noqa: E402
 
 CASE = sys.argv[sys.argv.index("--case") + 1]

@@ -1,4 +1,5 @@
-// Internal, not rsg's API (FrameCodec holds one by value, so its header must see it).
+// Internal, not rsg's API (FrameCodec holds one by value, so its header must see it): namespace
+// rsg::wire::detail, installed, free to change in any release (CONTRIBUTING.md, "Layers").
 // Which bytes go where when one selection's fields move between a frame and a struct.
 //
 // The field walk (44 rows: present? where on the wire? where in the struct?) is done once per
@@ -17,7 +18,7 @@
 #include "rsg/wire/frame.hpp"
 #include "rsg/wire/selection.hpp"
 
-namespace rsg::wire {
+namespace rsg::wire::detail {
 
 /// Frame bytes [frame_begin, frame_end) correspond to the struct bytes at the same offsets plus
 /// `struct_delta`. Offsets count from the start of the frame, header included.
@@ -68,7 +69,7 @@ class CopyPlan {
 };
 
 /// A copy plan's moves cut into 64-byte chunks, for a copy that goes a chunk at a time: the
-/// stitched CRC kernel (src/wire/crc32_copy.hpp). The chunks cover the CRC-covered bytes preceded
+/// stitched CRC kernel (src/wire/internal/crc32_copy.hpp). The chunks cover the CRC-covered bytes preceded
 /// by `head_padding()` zero bytes, so that they end where the frame ends; positions and deltas
 /// here count in that padded frame. Built once per selection and kept by `FrameCodec`.
 class ChunkedCopyPlan {
@@ -98,4 +99,4 @@ class ChunkedCopyPlan {
   static_assert(kMaxChunks <= 64, "whole_chunks_ has a bit per chunk");
 };
 
-}  // namespace rsg::wire
+}  // namespace rsg::wire::detail

@@ -3,7 +3,7 @@
 
 #include <string_view>
 
-namespace rsg::wire {
+namespace rsg::wire::internal {
 
 /// `text` without the ASCII white space (space, tab, CR, LF, VT, FF) at either end.
 constexpr std::string_view trim(std::string_view text) noexcept {
@@ -13,4 +13,4 @@ constexpr std::string_view trim(std::string_view text) noexcept {
   return text.substr(first, text.find_last_not_of(kWhitespace) - first + 1);
 }
 
-}  // namespace rsg::wire
+}  // namespace rsg::wire::internal

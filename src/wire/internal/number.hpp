@@ -7,7 +7,7 @@
 #include <string_view>
 #include <system_error>
 
-namespace rsg::wire {
+namespace rsg::wire::internal {
 
 /// Parses all of `text` as one decimal number of type `Number` (an integer or a floating-point type).
 /// @return the number; std::nullopt when `text` is empty, has anything before or after the number
@@ -21,4 +21,4 @@ std::optional<Number> parse_number(std::string_view text) noexcept {
   return value;
 }
 
-}  // namespace rsg::wire
+}  // namespace rsg::wire::internal

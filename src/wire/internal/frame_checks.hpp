@@ -13,9 +13,9 @@
 #include "rsg/wire/detail/copy_plan.hpp"
 #include "rsg/wire/error_flags.hpp"
 #include "rsg/wire/frame.hpp"
-#include "wire/group_bytes.hpp"
+#include "wire/internal/group_bytes.hpp"
 
-namespace rsg::wire::detail {
+namespace rsg::wire::internal {
 
 static_assert(std::endian::native == std::endian::little,
               "fields are copied as raw little-endian bytes; a big-endian host needs byte swaps");
@@ -234,8 +234,8 @@ inline void zero_small(std::byte* p, std::size_t size) {
 
 // A full frame leaves only the high bytes of its 5-byte error sets (3 bytes each): stored in place
 // rather than through a memset call per fill.
-inline void zero_fills(const CopyPlan& plan, void* base) {
-  for (const ByteFill& fill : plan.fills()) {
+inline void zero_fills(const detail::CopyPlan& plan, void* base) {
+  for (const detail::ByteFill& fill : plan.fills()) {
     std::byte* at = static_cast<std::byte*>(base) + fill.begin;
     if (fill.size <= 16)
       zero_small(at, fill.size);
@@ -330,4 +330,4 @@ class FrameDecoder {
   }
 };
 
-}  // namespace rsg::wire::detail
+}  // namespace rsg::wire::internal

@@ -8,7 +8,7 @@
 #include "rsg/wire/field_table.hpp"
 #include "rsg/wire/selection.hpp"
 
-namespace rsg::wire::detail {
+namespace rsg::wire::internal {
 
 /// kSelectedBytes[g][m]: bytes that group g carries when data_select[g] is m.
 inline constexpr auto kSelectedBytes = [] {
@@ -25,4 +25,4 @@ constexpr std::uint16_t offset_in_group(const FieldInfo& field, const Selection&
   return kSelectedBytes[field.group][selection.data_select[field.group] & (field.mask - 1U)];
 }
 
-}  // namespace rsg::wire::detail
+}  // namespace rsg::wire::internal

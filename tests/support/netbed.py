@@ -25,8 +25,6 @@ import threading
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "integration"))
-
 from harness import TestFailure, check  # noqa: E402,F401
 
 HOSTS = {"robot": "198.18.0.1", "gw": "198.18.0.2", "ops1": "198.18.0.3", "ops2": "198.18.0.4"}

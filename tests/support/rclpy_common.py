@@ -17,7 +17,7 @@ from harness import check, wait_for
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
-PEER = HERE / "rclpy_peer.py"
+PEER = REPO / "tests" / "ros2" / "rclpy_peer.py"
 
 
 class RosEnv:
@@ -178,3 +178,19 @@ def read_messages(h, label):
     path = h.output(label)
     text = path.read_text() if path.exists() else ""
     return [json.loads(line) for line in text.split("\n")[:-1] if line.strip()]
+
+
+def check_in_order(label, sent, got, member_order):
+    """Every message equals a sent frame, in the order sent; returns the positions matched."""
+    expected = [expected_message(frame, member_order) for frame in sent]
+    positions, position = [], 0
+    for index, message in enumerate(got):
+        while position < len(expected) and same_message(expected[position], message):
+            position += 1
+        if position == len(expected):
+            closest = min(expected, key=lambda e: abs(e["packet_number"] - message["packet_number"]))
+            check(False, f"{label}: message {index} is no frame sent after the previous one: "
+                         f"{same_message(closest, message)}")
+        positions.append(position)
+        position += 1
+    return positions

@@ -14,13 +14,11 @@ import signal
 import socket
 import struct
 import subprocess
-import sys
 import tempfile
 import threading
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "support"))
 from test_domain import acquire_domain, test_domain  # noqa: E402,F401  (re-exported to the tests)
 
 # Generous on purpose: a 2-core machine shared with builds makes discovery and start-up slow.

@@ -13,34 +13,36 @@
 
 #include "rsg/wire/detail/copy_plan.hpp"
 
-namespace rsg::wire::detail {
+namespace rsg::wire::internal {
 
 /// Decoding: returns the CRC-32 of `frame` and copies the bytes of each of the plan's moves to `base`.
-std::uint32_t crc32_scatter(std::span<const std::uint8_t> frame, const ChunkedCopyPlan& plan,
+std::uint32_t crc32_scatter(std::span<const std::uint8_t> frame, const detail::ChunkedCopyPlan& plan,
                             std::byte* base) noexcept;
 
 /// Encoding: fills the bytes of each move from `base`, keeps the other bytes of `frame` (the
 /// header) and returns the CRC-32 of the result.
-std::uint32_t gather_crc32(std::span<std::uint8_t> frame, const ChunkedCopyPlan& plan,
+std::uint32_t gather_crc32(std::span<std::uint8_t> frame, const detail::ChunkedCopyPlan& plan,
                            const std::byte* base) noexcept;
 
 /// The moves alone, without a CRC: frame to struct, and struct to frame.
-void copy_to_struct(std::span<const std::uint8_t> frame, const CopyPlan& plan, std::byte* base) noexcept;
-void copy_to_frame(std::span<std::uint8_t> frame, const CopyPlan& plan, const std::byte* base) noexcept;
+void copy_to_struct(std::span<const std::uint8_t> frame, const detail::CopyPlan& plan,
+                    std::byte* base) noexcept;
+void copy_to_frame(std::span<std::uint8_t> frame, const detail::CopyPlan& plan,
+                   const std::byte* base) noexcept;
 
 // The implementations behind the two, picked once by CPU; exposed for the tests.
 
 /// True where the stitched kernel runs: AVX-512 (F, BW, DQ, VL), VPCLMULQDQ and BMI2.
 bool has_stitched_crc32() noexcept;
 /// Any x86-64: ISA-L's CRC, then one memcpy per move.
-std::uint32_t crc32_scatter_portable(std::span<const std::uint8_t> frame, const ChunkedCopyPlan& plan,
+std::uint32_t crc32_scatter_portable(std::span<const std::uint8_t> frame, const detail::ChunkedCopyPlan& plan,
                                      std::byte* base) noexcept;
-std::uint32_t gather_crc32_portable(std::span<std::uint8_t> frame, const ChunkedCopyPlan& plan,
+std::uint32_t gather_crc32_portable(std::span<std::uint8_t> frame, const detail::ChunkedCopyPlan& plan,
                                     const std::byte* base) noexcept;
 /// Only where has_stitched_crc32().
-std::uint32_t crc32_scatter_stitched(std::span<const std::uint8_t> frame, const ChunkedCopyPlan& plan,
+std::uint32_t crc32_scatter_stitched(std::span<const std::uint8_t> frame, const detail::ChunkedCopyPlan& plan,
                                      std::byte* base) noexcept;
-std::uint32_t gather_crc32_stitched(std::span<std::uint8_t> frame, const ChunkedCopyPlan& plan,
+std::uint32_t gather_crc32_stitched(std::span<std::uint8_t> frame, const detail::ChunkedCopyPlan& plan,
                                     const std::byte* base) noexcept;
 
-}  // namespace rsg::wire::detail
+}  // namespace rsg::wire::internal
