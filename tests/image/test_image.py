@@ -38,7 +38,6 @@ import os
 import re
 import shlex
 import shutil
-import socket
 import subprocess
 import sys
 import tempfile
@@ -49,7 +48,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "support"))
-from harness import (TestFailure, check, free_udp_port, read_json_lines, wait_for, wait_for_stats,  # noqa: E402
+from harness import (TestFailure, check, free_tcp_port, free_udp_port, read_json_lines, wait_for, wait_for_stats,  # noqa: E402
                      wait_reader_matched)
 from metrics_support import http_get, parse_samples, value_of  # noqa: E402
 from dds_attacks import (TWO_LOCATORS_PROFILE, TWO_LOCATORS_XML, guard_counts, one_datagram,  # noqa: E402
@@ -62,12 +61,6 @@ COUNT = 1000
 # Inside the image: the entrypoint's stats file (the HEALTHCHECK reads it) and where tests mount.
 STATS_DIR, DATA = "/run/rsg", "/data"
 IMAGE_UID = 10001  # the image's user (docker/Dockerfile)
-
-
-def free_tcp_port():
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 class Containers:

@@ -11,16 +11,9 @@ what is wrong, with the numbers, and what to check.
    after three tries the gateway warns once, with the numbers, and slows down.
 """
 
-import socket
 import sys
 
-from harness import acquire_domain, check, free_udp_port, main, read_json, wait_for, wait_for_stats
-
-
-def free_tcp_port():
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
+from harness import acquire_domain, check, free_tcp_port, free_udp_port, main, read_json, wait_for, wait_for_stats
 
 
 def stderr_of(h, label):

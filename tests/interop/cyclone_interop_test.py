@@ -17,7 +17,7 @@ import tempfile
 import time
 import unittest
 
-from test_domain import test_domain  # noqa: E402  (a DDS domain this test alone holds)
+from test_domain import test_domain, test_port  # noqa: E402  (a DDS domain, and ports, this test alone holds)
 
 ARGS = None
 TOPIC = "robot_state"
@@ -96,9 +96,7 @@ class CycloneInterop(unittest.TestCase):
             sink.bind(("127.0.0.1", 0))
             sink.settimeout(30)
             sink_port = sink.getsockname()[1]
-            with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-                probe.bind(("127.0.0.1", 0))
-                listen_port = probe.getsockname()[1]
+            listen_port = test_port()
             gateway = subprocess.Popen(
                 [os.environ["RSG_GATEWAY"], "--listen", f"127.0.0.1:{listen_port}", "--domain", str(test_domain()),
                  "--topic", "robot_state_in", "--partition", PARTITION, "--egress-topic", TOPIC,

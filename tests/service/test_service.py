@@ -59,7 +59,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "support"))
-from harness import TestFailure, check, free_udp_port, read_json_lines, wait_for  # noqa: E402
+from harness import TestFailure, check, free_tcp_port, free_udp_port, read_json_lines, wait_for  # noqa: E402
 from metrics_support import http_get, parse_samples, value_of  # noqa: E402
 from dds_attacks import (TWO_LOCATORS_PROFILE, TWO_LOCATORS_XML, guard_counts, one_datagram,  # noqa: E402
                          random_datagrams, send_to_domain)
@@ -81,12 +81,6 @@ DOMAINS = (231, 232)
 # Left out of the before/after comparison: what apt, dpkg, journald and systemd keep for themselves.
 VOLATILE = re.compile(r"^(/var/lib/(apt|dpkg|systemd)|/var/cache|/var/log|/run/(systemd|log|dbus|lock|user)"
                       r"|/etc/ld\.so\.cache)(/|$)")
-
-
-def free_tcp_port():
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 def claim_domain():

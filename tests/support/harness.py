@@ -19,7 +19,7 @@ import threading
 import time
 from pathlib import Path
 
-from test_domain import acquire_domain, test_domain  # noqa: E402,F401  (re-exported to the tests)
+from test_domain import acquire_domain, test_domain, test_port  # noqa: E402,F401  (re-exported to the tests)
 
 # Generous on purpose: a 2-core machine shared with builds makes discovery and start-up slow.
 DEFAULT_WAIT_S = 20.0
@@ -71,10 +71,14 @@ def realtime_prefix():
 
 
 def free_udp_port():
-    """A port no one is bound to right now (the kernel's pick for port 0)."""
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
+    """A port of this test's own block, no one bound to it right now (test_domain.test_port: not the
+    kernel's pick for port 0, which another process's port-0 socket may take before ours binds it)."""
+    return test_port()
+
+
+def free_tcp_port():
+    """The same for a TCP server (a metrics or view port): the block's ports are free for both."""
+    return test_port()
 
 
 def port_is_free(port):

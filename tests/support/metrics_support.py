@@ -4,20 +4,12 @@ the gateway started with --metrics."""
 import http.client
 import re
 import shutil
-import socket
 
-from harness import TestFailure, check, free_udp_port, wait_for
+from harness import TestFailure, check, free_tcp_port, free_udp_port, wait_for  # noqa: F401 (free_tcp_port re-exported)
 
 # A sample line of the text exposition format: name, optional {labels}, value (no timestamps: rsg writes none).
 _SAMPLE = re.compile(r'^([a-zA-Z_:][a-zA-Z0-9_:]*)(\{(.*)\})? (\S+)$')
 _LABEL = re.compile(r'([a-zA-Z_][a-zA-Z0-9_]*)="((?:[^"\\]|\\.)*)"')
-
-
-def free_tcp_port():
-    """A TCP port no one listens on right now (the kernel's pick for port 0)."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 def http_get(port, path, timeout_s=5.0):

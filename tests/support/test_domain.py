@@ -8,8 +8,14 @@ worktree or ctest run they come from. The scan starts at an offset taken from th
 successive tests move through the pool rather than reusing the domain the last test just left.
 
 The pool, 20 to 99: a domain's ports (7400 + 250 * domain + ...: 12400 to 32400) stay below Linux's
-ephemeral range (32768 and up), so a port the kernel hands out for port 0 (harness.free_udp_port) is
-never one a DDS participant of another test binds, and ROS 2's valid domain ids (0 to 101) hold it.
+ephemeral range (32768 and up), and ROS 2's valid domain ids (0 to 101) hold it.
+
+The ports a test gives its processes (a gateway's --listen, a metrics or view server) come from a
+block of its domain's own, PORTS_PER_DOMAIN from FIRST_PORT (2000 to 7119: below every DDS domain's
+ports and below the ephemeral range): test_port(). A port the kernel picks for port 0 is free when
+picked, but a socket another process binds to port 0 meanwhile (Fast DDS's output sockets, any
+client) can take it before the test's process binds it ("Address already in use", seen under
+ctest -j); no other running test and no port-0 socket takes a port of the test's block.
 `tests/support/test_domain.hpp` is the same allocator for C++ tests: keep the two in step.
 
 As a command, for tests that are shell scripts:
@@ -18,7 +24,7 @@ As a command, for tests that are shell scripts:
 
 takes a domain, puts it into the environment as NAME (default RSG_TEST_DOMAIN) and execs COMMAND,
 which inherits the locked file and so holds the domain until it and its children exit; each
---port-env NAME puts there a port the kernel picked, free for UDP and TCP on 127.0.0.1 (a fixed
+--port-env NAME puts there a port of the domain's block, free for UDP and TCP on 127.0.0.1 (a fixed
 or pid-derived port may be one another test holds).
 """
 import argparse
@@ -30,8 +36,11 @@ import sys
 LOCK_DIR = os.environ.get("RSG_TEST_LOCK_DIR", "/tmp/rsg-test-domains")
 FIRST_DOMAIN = 20
 LAST_DOMAIN = 99
+FIRST_PORT = 2000
+PORTS_PER_DOMAIN = 64
 
 _held = {}  # domain -> file descriptor holding its lock
+_next_port = {}  # domain -> index in its block of the next port to try
 
 
 def acquire_domain(inheritable=False):
@@ -66,18 +75,30 @@ def test_domain():
     return next(iter(_held)) if _held else acquire_domain()
 
 
-def free_port():
-    """A port the kernel picked (port 0) that is free for both UDP and TCP on 127.0.0.1 right now."""
-    while True:
-        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as udp:
-            udp.bind(("127.0.0.1", 0))
-            port = udp.getsockname()[1]
-            with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as tcp:
-                try:
-                    tcp.bind(("127.0.0.1", port))
-                    return port
-                except OSError:
-                    continue
+def _bindable(port):
+    """Whether both UDP and TCP can bind `port` on 127.0.0.1 right now."""
+    try:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as udp, \
+                socket.socket(socket.AF_INET, socket.SOCK_STREAM) as tcp:
+            udp.bind(("127.0.0.1", port))
+            tcp.bind(("127.0.0.1", port))
+            return True
+    except OSError:
+        return False
+
+
+def test_port():
+    """A port of this test's block, free for UDP and TCP on 127.0.0.1 right now; each call the next
+    one (two processes of one test start at different places of the block: the pid)."""
+    domain = test_domain()
+    base = FIRST_PORT + (domain - FIRST_DOMAIN) * PORTS_PER_DOMAIN
+    start = _next_port.get(domain, os.getpid() % PORTS_PER_DOMAIN)
+    for step in range(PORTS_PER_DOMAIN):
+        index = (start + step) % PORTS_PER_DOMAIN
+        if _bindable(base + index):
+            _next_port[domain] = index + 1
+            return base + index
+    raise RuntimeError(f"no free port in domain {domain}'s block {base}-{base + PORTS_PER_DOMAIN - 1} on 127.0.0.1")
 
 
 def main():
@@ -92,7 +113,7 @@ def main():
     domain = acquire_domain(inheritable=True)
     os.environ[args.env] = str(domain)
     for name in args.port_env:
-        os.environ[name] = str(free_port())
+        os.environ[name] = str(test_port())
     os.execvp(command[0], command)
 
 

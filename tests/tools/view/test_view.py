@@ -18,7 +18,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[2]
-from harness import check, free_udp_port, main, read_json_lines, wait_for, wait_for_stats, wait_reader_matched  # noqa: E402
+from harness import check, free_tcp_port, free_udp_port, main, read_json_lines, wait_for, wait_for_stats, wait_reader_matched  # noqa: E402
 
 CASE = sys.argv[sys.argv.index("--case") + 1]
 del sys.argv[sys.argv.index("--case"):sys.argv.index("--case") + 2]
@@ -27,12 +27,6 @@ if "--screenshot" in sys.argv:
     SCREENSHOT = sys.argv[sys.argv.index("--screenshot") + 1]
     del sys.argv[sys.argv.index("--screenshot"):sys.argv.index("--screenshot") + 2]
 SELECTIONS = ["--every", "1:q,dq,time", "--every", "3:g0", "--every", "10:all"]
-
-
-def free_tcp_port():
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 def node():
