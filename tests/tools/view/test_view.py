@@ -294,6 +294,7 @@ def attack_subscriptions(h):
     rss_during = rss_kb(view.pid)
     legit_client(h, "legit", ws_port, 1000, 10000)
     check(h.wait("attacker", attacker, 30) == 0, f"the attacker failed: {(h.dir / 'attacker.err').read_text()}")
+    check(h.wait("crowd", crowd, 30) == 0, f"the one-address attacker failed: {(h.dir / 'crowd.err').read_text()}")
     cpu = (cpu_s(view.pid) - cpu_before) / (time.monotonic() - start)
     result = json.loads(h.output("attacker").read_text().splitlines()[-1])
     time.sleep(2.0)
@@ -332,8 +333,8 @@ def attack_idle_clients(h):
 
 
 def attack_tcp(h):
-    """1,100 TCP connections that never send a byte, from 10 addresses, each renewed as soon as
-    rsg_view closes it, for 8 s: rsg_view never holds more than --max-connections (64) of them, a
+    """1,100 TCP connections that never send a byte, from 10 addresses, and 100 from one of them, each
+    renewed as soon as rsg_view closes it, for 8 s: rsg_view never holds more than --max-connections (64) of them, a
     legitimate client gets its data meanwhile, and the limits are counted. Then a second rsg_view,
     whose --max-connections is past its fd limit (prlimit --nofile 64): accept fails with EMFILE and
     it backs off instead of spinning (under a third of a core), counted as `accept_failures`."""
@@ -341,6 +342,10 @@ def attack_tcp(h):
     sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "60000"])
     fds_before, cpu_before, start = open_fds(view.pid), cpu_s(view.pid), time.monotonic()
     attacker = h.start("attacker", [node(), ATTACK, "tcp", "127.0.0.1", str(ws_port), "1100", "10", "8000"])
+    # ... and 100 more from one of those addresses: past the per-address limit (8) whatever the order
+    # in which the others arrive (spread evenly, ten addresses can share 64 slots without any of them
+    # holding 8).
+    crowd = h.start("crowd", [node(), ATTACK, "tcp", "127.0.0.1", str(ws_port), "100", "1", "8000"])
     time.sleep(2.0)
     fds_during = 0
     for _ in range(20):
@@ -348,6 +353,7 @@ def attack_tcp(h):
         time.sleep(0.05)
     legit_client(h, "legit", ws_port, 200, 5000)
     check(h.wait("attacker", attacker, 30) == 0, f"the attacker failed: {(h.dir / 'attacker.err').read_text()}")
+    check(h.wait("crowd", crowd, 30) == 0, f"the one-address attacker failed: {(h.dir / 'crowd.err').read_text()}")
     cpu = (cpu_s(view.pid) - cpu_before) / (time.monotonic() - start)
     result = json.loads(h.output("attacker").read_text().splitlines()[-1])
     print(f"[{h.name}] attacker: {result}; rsg_view fds {fds_before} before, {fds_during} at most during; "
