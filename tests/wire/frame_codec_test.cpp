@@ -73,10 +73,13 @@ void fill_random(std::span<std::byte> bytes, std::mt19937_64& rng) {
   for (std::byte& byte : bytes) byte = static_cast<std::byte>(rng());
 }
 
-class StitchedKernel : public ::testing::Test {
+/// The CRC-and-copy kernel this CPU runs (the stitched AVX-512 one where has_stitched_crc32(), the
+/// portable one elsewhere: the stitched one cannot run without AVX-512), checked against references
+/// that share nothing with either: ISA-L's CRC of the whole frame and one memcpy per move.
+class CrcCopyKernel : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!wire::internal::has_stitched_crc32()) GTEST_SKIP() << "no AVX-512 VPCLMULQDQ on this CPU";
+    RecordProperty("kernel", wire::internal::has_stitched_crc32() ? "stitched (AVX-512)" : "portable");
   }
 };
 
@@ -128,37 +131,34 @@ class KernelCase {
   std::vector<std::byte> expected_;
 };
 
-TEST_F(StitchedKernel, ScatterMatchesIsalAndMemcpy) {
+TEST_F(CrcCopyKernel, ScatterMatchesIsalAndMemcpy) {
   std::mt19937_64 rng(20261121);
   Arena arena(8);
   for (int round = 0; round < 20'000; ++round) {
     KernelCase input(rng, arena, /*struct_is_destination=*/true);
-    const std::uint32_t expected =
-        wire::internal::crc32_scatter_portable(input.frame(), input.plan(), input.expected_struct());
+    wire::internal::copy_to_struct(input.frame(), input.plan().plan(), input.expected_struct());
     const std::uint32_t actual =
-        wire::internal::crc32_scatter_stitched(input.frame(), input.plan(), input.struct_base());
+        wire::internal::crc32_scatter(input.frame(), input.plan(), input.struct_base());
     ASSERT_EQ(actual, wire::crc32(input.frame())) << "round " << round;
-    ASSERT_EQ(actual, expected);
     ASSERT_TRUE(input.same_as_expected()) << "round " << round;
   }
 }
 
-TEST_F(StitchedKernel, GatherMatchesMemcpyAndIsal) {
+TEST_F(CrcCopyKernel, GatherMatchesMemcpyAndIsal) {
   std::mt19937_64 rng(7);
   Arena arena(8);
   for (int round = 0; round < 20'000; ++round) {
     KernelCase input(rng, arena, /*struct_is_destination=*/false);
-    const std::uint32_t expected =
-        wire::internal::gather_crc32_portable(input.expected_frame(), input.plan(), input.struct_base());
+    wire::internal::copy_to_frame(input.expected_frame(), input.plan().plan(), input.struct_base());
     const std::uint32_t actual =
-        wire::internal::gather_crc32_stitched(input.frame(), input.plan(), input.struct_base());
-    ASSERT_EQ(actual, expected) << "round " << round;
+        wire::internal::gather_crc32(input.frame(), input.plan(), input.struct_base());
+    ASSERT_EQ(actual, wire::crc32(input.expected_frame())) << "round " << round;
     ASSERT_EQ(actual, wire::crc32(input.frame()));
     ASSERT_TRUE(input.same_as_expected()) << "round " << round;
   }
 }
 
-TEST_F(StitchedKernel, EveryHeadPaddingASelectionCanHave) {
+TEST_F(CrcCopyKernel, EveryHeadPaddingASelectionCanHave) {
   // The padding in front of the first chunk is 64 minus the frame's length mod 64, so it follows
   // the selection. Field sizes are multiples of 8 plus the 5-, 5- and 1-byte fields, so not every
   // padding occurs; visit each one that does, with paddings 61 and 62, where the frame's first four
@@ -176,9 +176,8 @@ TEST_F(StitchedKernel, EveryHeadPaddingASelectionCanHave) {
     for (std::uint8_t& byte : covered) byte = static_cast<std::uint8_t>(rng());
     wire::StateValues expected;
     wire::StateValues actual;
-    EXPECT_EQ(
-        wire::internal::crc32_scatter_stitched(covered, plan, static_cast<std::byte*>(actual.storage())),
-        wire::crc32(covered))
+    EXPECT_EQ(wire::internal::crc32_scatter(covered, plan, static_cast<std::byte*>(actual.storage())),
+              wire::crc32(covered))
         << "padding " << plan.head_padding();
     wire::internal::copy_to_struct(covered, plan.plan(), static_cast<std::byte*>(expected.storage()));
     EXPECT_EQ(std::memcmp(actual.storage(), expected.storage(), wire::StateValues::storage_size()), 0)
