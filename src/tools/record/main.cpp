@@ -2,9 +2,8 @@
 // every sample to an MCAP file as the CDR bytes a DDS writer sends, with the schema to decode them.
 //
 // With --trigger it records only around events (SIGUSR1, the gateway's link going down, invalid
-// frames): the last
-// --pre seconds of samples wait in memory, bounded by --trigger-buffer, and an event writes them and
-// the --post seconds after it to a file of their own.
+// frames): the last --pre seconds of samples wait in memory, bounded by --trigger-buffer, and an
+// event writes them and the --post seconds after it to a file of their own.
 //
 // Exit status: 0 after --duration or on SIGINT/SIGTERM with the file finished; 1 when the file
 // cannot be written (the error names it; what was recorded stays readable), DDS fails or no writer
