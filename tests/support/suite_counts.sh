@@ -7,6 +7,11 @@ count_ctest() {  # LOG: adds ctest's "97% tests passed, 3 tests failed out of 10
   local bad total
   if read -r bad total < <(sed -nE 's/.* tests passed, ([0-9]+) tests? failed out of ([0-9]+).*/\1 \2/p' "$1" | tail -n 1); then
     passed=$((passed + total - bad)); failed=$((failed + bad))
+    # A failed test's output, which ctest --output-on-failure prints after its result line, shown
+    # whole (the suites print only the result lines of their runs), its last 60 lines each.
+    ((bad == 0)) || awk '/^ *[0-9]+\/[0-9]+ Test .*\*\*\*/ {keep = 1; n = 0}
+                         /^ *[0-9]+\/[0-9]+ Test .*Passed|^ *Start +[0-9]+:/ {keep = 0}
+                         keep && n++ < 60' "$1"
   else
     echo "$1: no ctest summary" >&2; failed=$((failed + 1))
   fi
