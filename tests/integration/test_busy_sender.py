@@ -1,7 +1,7 @@
-"""A sender stopped (SIGSTOP) for 150 ms in mid-stream, then let go: rsg_sim sends the frames due
-meanwhile in a burst, as a descheduled sender or a switch's buffer delivers them, each frame's `time`
-1 ms after the one before but all arriving at once. Bunched frames are no forgery: the gateway
-publishes every one, none out of sequence, none lost, and no restart."""
+"""A sender stopped (SIGSTOP) for 150 ms in mid-stream, then let go: the gateway publishes every
+frame, none out of sequence, none lost, and counts no restart. rsg_sim goes on with the robot's
+clock run on (its report counts a stall), as a robot's controller that misses cycles does; that
+bunched frames are no forgery either, the sequence tracker's unit tests show."""
 
 import signal
 import sys
@@ -27,7 +27,7 @@ def body(h):
     sim.send_signal(signal.SIGCONT)
     check(h.wait("sim", sim, 30) == 0, "rsg_sim did not exit 0")
     report = read_json(report_path)
-    check(report["sent"] == SENT and report["longest_gap_us"] >= 100_000, f"sim report: {report}")
+    check(report["sent"] == SENT and report["stalls"] >= 1, f"sim report: {report}")
 
     final = wait_for_stats(stats, lambda s: s["frames_received"] >= SENT, "the gateway to count every datagram")
     counts = {key: final[key] for key in ("frames_published", "out_of_sequence", "lost", "robot_restarts")}

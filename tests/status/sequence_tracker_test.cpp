@@ -146,6 +146,16 @@ TEST(SequenceTracker, PauseWithTimeRunningOnIsNoLoss) {
   EXPECT_EQ(tracker.counts(), Counts{});
 }
 
+// A sender descheduled for 150 ms that then sends the frames due meanwhile at once (or a switch that
+// delivers them so): each frame 1 ms after the one before on the robot's clock, all arriving together.
+TEST(SequenceTracker, FramesBunchedAfterAStallAreInSequence) {
+  Tracker tracker;
+  for (std::uint64_t i = 0; i < 100; ++i) ASSERT_EQ(tracker.observe_at(i, i % 16, 1000 + i), Verdict::kInSequence);
+  for (std::uint64_t i = 100; i < 250; ++i)
+    EXPECT_EQ(tracker.observe_at(250, i % 16, 1000 + i), Verdict::kInSequence) << "frame " << i;
+  EXPECT_EQ(tracker.counts(), Counts{});
+}
+
 TEST(SequenceTracker, ARobotRebootingAfterAPauseIsARestartAtOnce) {
   Tracker tracker(100);
   for (std::uint8_t i = 0; i < 40; ++i) tracker.observe(i % 16, 10'000 + i);

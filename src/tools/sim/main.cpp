@@ -52,7 +52,9 @@ Time:
   `time` is whole milliseconds of robot time since (re)start, frame k being k/rate seconds in (plus
   pauses). Above 1 kHz consecutive frames share a millisecond, so `time` repeats (non-decreasing
   instead of strictly increasing); the packet number still changes every frame. The motion is
-  computed at the exact frame instant, not at the rounded millisecond.
+  computed at the exact frame instant, not at the rounded millisecond. A host too busy to send a
+  frame within 2 ms of its time stalls the robot: time runs on and the stream goes on from there,
+  without a burst of the frames due meanwhile (counted in the report's "stalls").
 
 Faults:
   A frame suffers at most one fault. --X-every N hits frames N-1, 2N-1, ... (drop, corrupt, duplicate,
@@ -66,7 +68,7 @@ Report (--report FILE, and a summary on stderr):
   {"sent","valid","dropped","duplicated","reordered",
    "invalid":{"truncated","length_mismatch","bad_crc","bad_request","reserved_bits",
               "selection_mismatch","bad_value"},
-   "restarts","pauses","selection_requests","invalid_requests","send_failures","longest_gap_us"}
+   "restarts","pauses","stalls","selection_requests","invalid_requests","send_failures","longest_gap_us"}
   sent = valid + all invalid (datagrams on the wire, a duplicate counted twice).)";
 
 /// Parses --corrupt-categories' comma-separated list of docs/protocol.md's error categories.

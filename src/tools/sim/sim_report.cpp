@@ -22,6 +22,7 @@ std::string SimReport::to_json() const {
       {"invalid", invalid_by_category},
       {"restarts", restarts},
       {"pauses", pauses},
+      {"stalls", stalls},
       {"selection_requests", selection_requests},
       {"invalid_requests", invalid_requests},
       {"send_failures", send_failures},
@@ -40,6 +41,7 @@ std::string SimReport::summary() const {
           ", reordered " + std::to_string(reordered) + ", restarts " + std::to_string(restarts) +
           ", pauses " + std::to_string(pauses) + ", selection requests " +
           std::to_string(selection_requests) + " (invalid " + std::to_string(invalid_requests) + ")";
+  if (stalls != 0) line += ", stalls " + std::to_string(stalls);
   if (send_failures != 0) line += ", send failures " + std::to_string(send_failures);
   return line;
 }

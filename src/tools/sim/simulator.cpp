@@ -76,6 +76,11 @@ std::chrono::nanoseconds Simulator::step(DatagramSink& sink) {
   return {};
 }
 
+void Simulator::stall(std::chrono::nanoseconds late) {
+  paused_since_boot_ += late;
+  ++report_.stalls;
+}
+
 void Simulator::finish(DatagramSink& sink) {
   if (!holding_) return;
   emit(held_, sink);

@@ -54,6 +54,9 @@ class Simulator {
   /// Produces the next frame and hands `sink` what the faults make of it. Returns how long the link
   /// must now stay silent (zero but once with `pause_after`). Does not allocate unless recording.
   std::chrono::nanoseconds step(DatagramSink& sink);
+  /// The host ran the simulator `late` behind its schedule: the robot's clock ran on meanwhile, and
+  /// the frames due in that time are not sent in a burst (a robot does not catch up that way).
+  void stall(std::chrono::nanoseconds late);
   /// Sends a frame still held back for reordering. Call once at the end of the stream.
   void finish(DatagramSink& sink);
 
