@@ -150,7 +150,8 @@ TEST(SequenceTracker, PauseWithTimeRunningOnIsNoLoss) {
 // delivers them so): each frame 1 ms after the one before on the robot's clock, all arriving together.
 TEST(SequenceTracker, FramesBunchedAfterAStallAreInSequence) {
   Tracker tracker;
-  for (std::uint64_t i = 0; i < 100; ++i) ASSERT_EQ(tracker.observe_at(i, i % 16, 1000 + i), Verdict::kInSequence);
+  for (std::uint64_t i = 0; i < 100; ++i)
+    ASSERT_EQ(tracker.observe_at(i, i % 16, 1000 + i), Verdict::kInSequence);
   for (std::uint64_t i = 100; i < 250; ++i)
     EXPECT_EQ(tracker.observe_at(250, i % 16, 1000 + i), Verdict::kInSequence) << "frame " << i;
   EXPECT_EQ(tracker.counts(), Counts{});
