@@ -76,7 +76,8 @@ std::chrono::nanoseconds Simulator::step(DatagramSink& sink) {
   return {};
 }
 
-void Simulator::stall(std::chrono::nanoseconds late) {
+void Simulator::stall(std::chrono::nanoseconds late, DatagramSink& sink) {
+  finish(sink);
   paused_since_boot_ += late;
   ++report_.stalls;
 }

@@ -92,7 +92,7 @@ void stream(Simulator& sim, UdpLink& link, const StreamLimits& limits, const std
     wait_until(start + due, spin_window, stop);
     if (stop.load(std::memory_order_relaxed)) break;
     if (const nanoseconds behind = Clock::now() - (start + due); behind > kMostBehind) {
-      sim.stall(behind);
+      sim.stall(behind, link);
       paused += behind;
     }
     const std::uint64_t restarts = sim.report().restarts;

@@ -196,6 +196,25 @@ TEST(Simulator, PauseSilencesTheLinkWhileTheClockRuns) {
   EXPECT_EQ(tally.frames[10].packet_number, 10);
 }
 
+// A host too busy to keep the schedule: time runs on as in a pause, and a frame held back for
+// reordering goes out at once, in order, rather than a stall's length late behind the next one.
+TEST(Simulator, AStallRunsTheClockOnAndSendsTheHeldFrameInOrder) {
+  SimConfig config = config_with("1:time");
+  config.faults.reorder_every = 5;  // frame 4 is held back for frame 5
+  Simulator sim(config);
+  CapturingSink sink;
+  for (int i = 0; i < 5; ++i) sim.step(sink);
+  sim.stall(40ms, sink);
+  sim.step(sink);
+  const Tally tally(sink);
+  ASSERT_EQ(tally.frames.size(), 6U);
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(tally.frames[i].packet_number, i);
+  EXPECT_EQ(tally.frames[5].packet_number, 5);
+  EXPECT_EQ(tally.frames[5].integer(wire::Field::time), 45U);
+  EXPECT_EQ(sim.report().stalls, 1U);
+  EXPECT_EQ(sim.report().reordered, 0U);
+}
+
 TEST(Simulator, SelectionRequestReplacesTheSchedule) {
   Simulator sim(config_with("1:q"));
   CapturingSink sink;
@@ -247,8 +266,8 @@ TEST(SimReport, JsonHasEveryCounterAndCategory) {
   EXPECT_EQ(json["invalid"]["bad_crc"], 2);
   EXPECT_EQ(json["invalid"]["bad_value"], 1);
   EXPECT_EQ(json["invalid"].size(), wire::kErrorCategoryCount);
-  for (const char* key : {"dropped", "duplicated", "reordered", "restarts", "pauses", "selection_requests",
-                          "invalid_requests", "send_failures", "longest_gap_us"})
+  for (const char* key : {"dropped", "duplicated", "reordered", "restarts", "pauses", "stalls",
+                          "selection_requests", "invalid_requests", "send_failures", "longest_gap_us"})
     EXPECT_EQ(json[key], 0) << key;
 }
 
