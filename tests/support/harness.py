@@ -19,7 +19,7 @@ import threading
 import time
 from pathlib import Path
 
-from test_domain import acquire_domain, test_domain, test_port  # noqa: E402,F401  (re-exported to the tests)
+from test_domain import acquire_domain, others_running, test_domain, test_port  # noqa: E402,F401  (re-exported)
 
 # Generous on purpose: a 2-core machine shared with builds makes discovery and start-up slow.
 DEFAULT_WAIT_S = 20.0
@@ -194,7 +194,7 @@ class Harness:
             if process.poll() is None:
                 process.kill()
                 process.wait()
-        subprocess.run(["fastdds", "shm", "clean"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        clean_shared_memory()
         if not keep_outputs:
             shutil.rmtree(self.dir, ignore_errors=True)
 
@@ -209,10 +209,18 @@ class Harness:
                 print("\n".join(line[:300] for line in lines[-20:]))
 
 
+def clean_shared_memory():
+    """Removes the shared-memory files of Fast DDS processes that died (`fastdds shm clean`), only
+    while no other test runs: it takes a port whose lock file is not locked yet for a dead one, and a
+    participant of a test starting beside it can be between creating its port and locking it."""
+    if not others_running():
+        subprocess.run(["fastdds", "shm", "clean"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
 def main(name, body):
     """Runs `body(harness)`; exit 0 on success, 1 on failure (with the children's logs)."""
     harness = Harness(name)
-    subprocess.run(["fastdds", "shm", "clean"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    clean_shared_memory()
     passed = False
     try:
         body(harness)

@@ -70,6 +70,25 @@ def release_domain(domain):
     os.close(_held.pop(domain))
 
 
+def others_running():
+    """Whether a test other than this process holds a domain of the pool (is running now)."""
+    for domain in range(FIRST_DOMAIN, LAST_DOMAIN + 1):
+        if domain in _held:
+            continue
+        try:
+            fd = os.open(os.path.join(LOCK_DIR, f"{domain}.lock"), os.O_RDWR | os.O_CLOEXEC)
+        except FileNotFoundError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            fcntl.flock(fd, fcntl.LOCK_UN)
+        except BlockingIOError:
+            return True
+        finally:
+            os.close(fd)
+    return False
+
+
 def test_domain():
     """The DDS domain of this test: the first one the process acquired (acquired on the first call)."""
     return next(iter(_held)) if _held else acquire_domain()
