@@ -1,7 +1,7 @@
 """A sender stopped (SIGSTOP) for 150 ms in mid-stream, then let go: the gateway publishes every
-frame, none out of sequence, none lost, and counts no restart. rsg_sim goes on with the robot's
-clock run on (its report counts a stall), as a robot's controller that misses cycles does; that
-bunched frames are no forgery either, the sequence tracker's unit tests show."""
+frame, none out of sequence, none lost, and counts no restart. rsg_sim goes on from there (its
+report counts a stall) rather than sending the frames due meanwhile in a burst; that bunched frames
+are no forgery either, the sequence tracker's unit tests show."""
 
 import signal
 import sys

@@ -53,8 +53,9 @@ Time:
   pauses). Above 1 kHz consecutive frames share a millisecond, so `time` repeats (non-decreasing
   instead of strictly increasing); the packet number still changes every frame. The motion is
   computed at the exact frame instant, not at the rounded millisecond. A host too busy to send a
-  frame within 2 ms of its time stalls the robot: time runs on and the stream goes on from there,
-  without a burst of the frames due meanwhile (counted in the report's "stalls").
+  frame within 2 ms of when it is due stalls the stream: it goes on from there, the link silent
+  meanwhile, without a burst of the frames due (counted in the report's "stalls"; `time` is not
+  moved).
 
 Faults:
   A frame suffers at most one fault. --X-every N hits frames N-1, 2N-1, ... (drop, corrupt, duplicate,

@@ -21,8 +21,8 @@ struct SimReport {
   std::array<std::uint64_t, wire::kErrorCategoryCount> invalid{};
   std::uint64_t restarts = 0;
   std::uint64_t pauses = 0;
-  /// Times the host ran the simulator too late to keep its schedule: the robot's clock ran on
-  /// without frames, as in a short pause (udp_stream.cpp).
+  /// Times the host ran the simulator too late to keep its schedule, which then went on from there
+  /// (udp_stream.cpp): silences of the link that no --pause-after asked for.
   std::uint64_t stalls = 0;
   std::uint64_t selection_requests = 0;  ///< valid requests applied
   std::uint64_t invalid_requests = 0;    ///< datagrams received that are no valid request

@@ -76,11 +76,7 @@ std::chrono::nanoseconds Simulator::step(DatagramSink& sink) {
   return {};
 }
 
-void Simulator::stall(std::chrono::nanoseconds late, DatagramSink& sink) {
-  finish(sink);
-  paused_since_boot_ += late;
-  ++report_.stalls;
-}
+void Simulator::stall() { ++report_.stalls; }
 
 void Simulator::finish(DatagramSink& sink) {
   if (!holding_) return;

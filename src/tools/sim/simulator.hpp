@@ -54,11 +54,10 @@ class Simulator {
   /// Produces the next frame and hands `sink` what the faults make of it. Returns how long the link
   /// must now stay silent (zero but once with `pause_after`). Does not allocate unless recording.
   std::chrono::nanoseconds step(DatagramSink& sink);
-  /// The host ran the simulator `late` behind its schedule: the robot's clock ran on meanwhile, and
-  /// the frames due in that time are not sent in a burst (a robot does not catch up that way). A
-  /// frame held back for reordering goes out now, in order: behind the next frame it would arrive
-  /// as late as the stall, which a receiver may rightly take for something else than a reordering.
-  void stall(std::chrono::nanoseconds late, DatagramSink& sink);
+  /// Counts a stall: the host ran the simulator too late to keep its schedule, which then goes on
+  /// from there instead of catching up in a burst (udp_stream.cpp). The robot's time stays that of
+  /// its frames (frame k at k / rate, plus pauses), so a receiver sees the link silent for a while.
+  void stall();
   /// Sends a frame still held back for reordering. Call once at the end of the stream.
   void finish(DatagramSink& sink);
 

@@ -18,12 +18,13 @@ constexpr nanoseconds kSpinWindow = std::chrono::microseconds(200);
 // Sleeps are cut into slices so that a stop request ends a long pause promptly.
 constexpr nanoseconds kLongestSleep = std::chrono::milliseconds(50);
 constexpr double kRequestPollsPerSecond = 1000;
-// Further behind its schedule than this, the simulator has stalled (a busy host): it goes on from
-// now with the robot's clock run on, as a robot's controller that misses cycles does, instead of
-// sending the frames due meanwhile in a burst. Bunched frames are legal, but a burst across a
-// --restart-after turns the restart the receiver sees into a matter of timing (rsg's gateway believes
-// a restart once the old stream has been silent for 10 ms or more, status/sequence_tracker.hpp), and
-// the tests compare the receiver's counters with the simulator's report.
+// Further behind its schedule than this, the simulator has stalled (a busy host): the schedule goes
+// on from now instead of sending the frames due meanwhile in a burst. The robot's time is not moved:
+// a frame's `time` set before a send that the host then delays would let the next frame's time
+// run ahead of its arrival, which rsg's gateway rightly takes for another stream
+// (status/sequence_tracker.hpp). A burst is legal, but one across a --restart-after makes what the
+// receiver counts while it confirms the restart a matter of timing, and the tests compare the
+// receiver's counters with the simulator's report.
 constexpr nanoseconds kMostBehind = std::chrono::milliseconds(2);
 
 std::string describe(const wire::Selection& selection) {
@@ -92,7 +93,7 @@ void stream(Simulator& sim, UdpLink& link, const StreamLimits& limits, const std
     wait_until(start + due, spin_window, stop);
     if (stop.load(std::memory_order_relaxed)) break;
     if (const nanoseconds behind = Clock::now() - (start + due); behind > kMostBehind) {
-      sim.stall(behind, link);
+      sim.stall();
       paused += behind;
     }
     const std::uint64_t restarts = sim.report().restarts;

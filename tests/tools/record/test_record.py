@@ -314,6 +314,20 @@ def gateway_with_traced_recorder(h, inject, *record_flags):
     return port, gateway, stats, traced, out
 
 
+def wait_until_quiet(measure, quiet_s, what, timeout_s=30):
+    """Waits until `measure()` has kept its value for `quiet_s` seconds."""
+    value, since = measure(), time.monotonic()
+    deadline = since + timeout_s
+    while time.monotonic() < deadline:
+        now_value = measure()
+        if now_value != value:
+            value, since = now_value, time.monotonic()
+        elif time.monotonic() - since >= quiet_s:
+            return
+        time.sleep(0.05)
+    check(False, f"timed out after {timeout_s} s waiting for {what}")
+
+
 def strace_child(traced):
     """The pid of the one process strace (started as `traced`) runs."""
     children = Path(f"/proc/{traced.pid}/task/{traced.pid}/children").read_text().split()
@@ -326,15 +340,20 @@ def chunk_size_fsync(h):
     finds no larger one, and as many as the recorder reports); --fsync calls fdatasync on the file
     after every finished chunk and once at the end (strace, Debian's, counts the calls). strace also
     makes every fdatasync take 50 ms, a slow disk: the recorder falls seconds behind the stream and
-    still records every frame. (On SIGTERM it writes what its reader had received before closing;
-    this test does not tell that apart, since its last batch usually holds the rest already:
-    drain_on_sigterm does.)"""
+    still records every frame, stopped once its file has stopped growing. (What it writes on SIGTERM
+    is drain_on_sigterm's test.)"""
     chunk = 65536
     port, gateway, stats, traced, out = gateway_with_traced_recorder(h, "delay_enter=50000", "--chunk-size", str(chunk),
                                                                      "--fsync")
     record = run_sim(h, port, 2000, 1000)  # every field in every frame: about 2 KB a message
     wait_for_stats(stats, lambda s: s["frames_published"] >= 2000, "the gateway to publish every frame")
-    time.sleep(0.5)  # the last samples reach the recorder's DDS reader (not its file: that is seconds behind)
+    # The file is seconds behind, and on a loaded host the DDS reader may be too (the gateway repairs
+    # what a full reader history refused): stopped once the recorder has caught up, when its chunks
+    # (each one fdatasync) no longer follow each other 50 ms apart but come with the gateway's 1 Hz
+    # status samples (a chunk spans at most 1 s).
+    trace = h.dir / "fdatasync.trace"
+    wait_until_quiet(lambda: trace.read_text().count("fdatasync(") if trace.exists() else 0, 0.6,
+                     "the recorder to catch up with the stream")
     # SIGTERM to rsg_record itself (strace's child), as an operator would; strace then exits with it.
     os.kill(strace_child(traced), signal.SIGTERM)
     check(h.wait("record", traced, 30) == 0, f"rsg_record did not exit 0 on SIGTERM: {stderr_of(h, 'record')}")
