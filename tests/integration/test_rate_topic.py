@@ -53,7 +53,7 @@ def body(h):
     check(read_json_lines(h.output("full"))[-COUNT:] == sent, "the full-rate topic differs from what the sim sent")
     # Paced by the robot's time: one sample per 1/hz window that holds a frame. A sample is the first
     # frame at or after its due time, so it comes late by less than the robot's longest step between
-    # two frames (2 ms at 500 Hz, more where a stall of the sim on a busy host ran its clock on), and
+    # two frames (2 ms at 500 Hz, more wherever the robot's time jumps), and
     # the next is due a period after the due time: the least gap is the period less that step.
     sent_times = [frame["fields"]["time"] for frame in sent]
     steps = [b - a for a, b in zip(sent_times, sent_times[1:])]

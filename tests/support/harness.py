@@ -108,9 +108,9 @@ def read_json_lines(path):
 def paced_count(times_ms, period_ms):
     """How many of the frames stamped `times_ms` (the robot's `time`, in order) an output paced by
     the robot's time at one per `period_ms` takes: one per period-long window, from the first frame,
-    that holds a frame. The robot's clock runs on through a pause, and through a stall of rsg_sim on
-    a busy host (its report's `stalls`), with no frame due then: counting on frames sent times the
-    period would expect too many. After a gap of a period or more the pacing starts again from the
+    that holds a frame. The robot's clock runs on through a pause (rsg_sim's --pause-after, a real
+    robot's gap) with no frame due then: counting on frames sent times the period would expect too
+    many. After a gap of a period or more the pacing starts again from the
     next frame, which may take one window more or less."""
     return len({(t - times_ms[0]) // period_ms for t in times_ms}) if times_ms else 0
 
