@@ -8,6 +8,9 @@ JOBS       ?= $(shell nproc)
 # and those that must run alone are RUN_SERIAL (CONTRIBUTING.md, Tests). One more than the cores:
 # the tests mostly wait (about 95 CPU-s in a run of 150 s on 2 cores; docs/development.md).
 CTEST_JOBS ?= $(shell echo $$(( $$(nproc) + 1 )))
+# The test suites that run Fast DDS on the host get a /dev/shm of their own, so that a file another
+# run or build left there cannot abort them (tests/support/private_shm.sh says why).
+PRIVATE_SHM = $(CURDIR)/tests/support/private_shm.sh
 FUZZ_SECONDS ?= 30
 # make test's fuzzing: each fuzzer this long, from its seed corpus (a smoke run that keeps the loop
 # short); .ci/run gives it 20 s and `make fuzz FUZZ_SECONDS=600` is the long run.
@@ -105,7 +108,7 @@ unit-asan: deps-test
 	cmake -S . -B $(ASAN_BUILD) $(call generator,$(ASAN_BUILD)) -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-g1 -DCMAKE_C_FLAGS_DEBUG=-g1 \
 	      -DRSG_SANITIZE=ON $(CMAKE_COMMON)
 	cmake --build $(ASAN_BUILD) -j $(JOBS) --target unit_tests && echo "unit-asan: $(ASAN_BUILD) built in $$SECONDS s"
-	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) ctest --output-on-failure -j $(CTEST_JOBS) -L unit 2>&1 | tee ctest.log && \
+	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) $(PRIVATE_SHM) ctest --output-on-failure -j $(CTEST_JOBS) -L unit 2>&1 | tee ctest.log && \
 	  echo "unit-asan: ctest took $$SECONDS s"
 
 fuzz-build: deps-test
@@ -119,7 +122,7 @@ fuzz: fuzz-build
 # What a contributor runs: every ctest test but those labelled long or jazzy, side by side; the unit tests
 # again under ASan+UBSan; every fuzzer for TEST_FUZZ_SECONDS (docs/development.md has the time each part takes).
 test: build-tests
-	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -LE 'long|jazzy' 2>&1 | tee ctest.log && \
+	cd $(BUILD) && $(PRIVATE_SHM) ctest --output-on-failure -j $(CTEST_JOBS) -LE 'long|jazzy' 2>&1 | tee ctest.log && \
 	  echo "make test: ctest took $$SECONDS s"
 	$(MAKE) unit-asan
 	$(MAKE) fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS)
@@ -128,14 +131,14 @@ test: build-tests
 # The long scenarios (ctest label long: network namespaces, reliability under load, churn and
 # scale), most of them RUN_SERIAL; .ci/run runs it after make test.
 test-long: build-tests
-	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -L long 2>&1 | tee ctest-long.log
+	cd $(BUILD) && $(PRIVATE_SHM) ctest --output-on-failure -j $(CTEST_JOBS) -L long 2>&1 | tee ctest-long.log
 	@tests/summarize.sh $(BUILD)/ctest-long.log --
 
 # The rclpy tests again with ROS 2 Jazzy nodes (ctest label jazzy, tests/ros2/CMakeLists.txt: rclpy
 # 7.1 on Fast DDS 2.14 from make deps' .deps/ros2-jazzy against the gateway); make test runs them
 # with Kilted's. A part of its own in .ci/run: together they would exceed make test's time budget.
 test-jazzy: deps build-tests
-	cd $(BUILD) && ctest --output-on-failure -j $(CTEST_JOBS) -L jazzy 2>&1 | tee ctest-jazzy.log
+	cd $(BUILD) && $(PRIVATE_SHM) ctest --output-on-failure -j $(CTEST_JOBS) -L jazzy 2>&1 | tee ctest-jazzy.log
 	@tests/summarize.sh $(BUILD)/ctest-jazzy.log --
 
 # Only what the demo runs, with only the build and run packages: in $(BUILD) with its flags, the
@@ -180,14 +183,14 @@ clean:
 # 2.9.1 on the host (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/.
 .PHONY: test-fastdds3 bench-fastdds3
 test-fastdds3: build-tests
-	JOBS=$(JOBS) tests/fastdds3/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds3.log
+	JOBS=$(JOBS) $(PRIVATE_SHM) tests/fastdds3/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds3.log
 
 # Fast DDS 2.14.5 (ROS 2 Jazzy's LTS, its PyPI wheels in $(DEPS_DIR)/fastdds214) found on
 # CMAKE_PREFIX_PATH, and across versions with $(BUILD)'s 2.9.1 (tests/fastdds214/run.sh,
 # docs/fastdds-versions.md). Its own tree, build-fdds214/.
 .PHONY: test-fastdds214
 test-fastdds214: deps build-tests
-	JOBS=$(JOBS) DEPS_DIR=$(DEPS_DIR) tests/fastdds214/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds214.log
+	JOBS=$(JOBS) DEPS_DIR=$(DEPS_DIR) $(PRIVATE_SHM) tests/fastdds214/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds214.log
 
 # make bench's e2e suite on 2.9 (host) and 3.x (chroot) back to back, side by side (docs/benchmarks/fastdds3/).
 bench-fastdds3: build-tests
