@@ -352,6 +352,16 @@ const std::array kKeys = {
               [](const GatewayConfig& c) { return check_not_empty(c.reader_profile); }},
     ConfigKey{"status-profile", "XML data writer profile of the status topic", &GatewayConfig::status_profile,
               [](const GatewayConfig& c) { return check_not_empty(c.status_profile); }},
+    ConfigKey{"data-sharing",
+              "auto (as the XML profiles say: rsg's let same-host readers read the samples in shared memory) or "
+              "off (no writer or reader of the gateway shares memory with another process: the choice for a host "
+              "whose local users are not all trusted, docs/security.md)",
+              &GatewayConfig::data_sharing,
+              [](const GatewayConfig& c) {
+                return c.data_sharing == "auto" || c.data_sharing == "off"
+                           ? std::string()
+                           : "'" + c.data_sharing + "' is not one of auto, off";
+              }},
     ConfigKey{"discovery-server", transport::kDiscoveryServerHelp, &GatewayConfig::discovery_servers,
               [](const GatewayConfig& c) {
                 return check_each(c.discovery_servers, transport::parse_discovery_server);

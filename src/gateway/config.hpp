@@ -97,6 +97,7 @@ struct GatewayConfig {
   std::string writer_profile = "rsg_state_writer";
   std::string reader_profile = "rsg_state_reader";
   std::string status_profile = "rsg_status_writer";
+  std::string data_sharing = "auto";  ///< "auto" (as the profiles say) or "off" (gateway/entities.hpp)
 
   // Discovery without multicast (rsg/dds/discovery.hpp)
   std::vector<std::string> discovery_servers;

@@ -7,7 +7,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <stdexcept>
 
-#include "gateway/ros2_type_hash.hpp"
+#include "gateway/entities.hpp"
 #include "rsg/dds/robot_state.hpp"
 #include "rsg/error.hpp"
 
@@ -29,8 +29,10 @@ Egress::Egress(dds::Participant& participant, const Options& options)
 
   subscriber_ = dds::own(participant_, participant_.subscriber(options.partitions));
   fdds::Topic* topic = participant_.robot_state_topic(options.topic, options.type_name);
-  reader_ = dds::own(*subscriber_, create_reader_with_profile(*subscriber_, topic, options.reader_profile),
-                     "the RobotState reader with profile '" + options.reader_profile + "'");
+  reader_ =
+      dds::own(*subscriber_,
+               create_reader_with_profile(*subscriber_, topic, options.reader_profile, options.data_sharing),
+               "the RobotState reader with profile '" + options.reader_profile + "'");
   reader_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
   waitset_.attach_condition(reader_->get_statuscondition());
   waitset_.attach_condition(stop_);

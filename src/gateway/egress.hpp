@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "gateway/clock.hpp"
+#include "gateway/data_sharing.hpp"
 #include "gateway/log_throttle.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
@@ -62,6 +63,7 @@ class Egress {
     std::string type_name;  ///< "" : rsg::RobotState; else e.g. rsg::dds::kRos2RobotStateType
     std::vector<std::string> partitions;
     std::string reader_profile;
+    DataSharing data_sharing = DataSharing::kAsProfiled;  ///< of the reader (entities.hpp)
     std::vector<transport::Endpoint> destinations;
     /// Samples sent per second at most (each to every destination); > 0.
     double max_rate_hz = 1000;

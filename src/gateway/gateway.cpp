@@ -175,6 +175,10 @@ std::string status_topic_of(const GatewayConfig& config) {
   return config.ros2 ? dds::ros2_topic_name(config.ros2_namespace, "gateway_status") : config.status_topic;
 }
 
+DataSharing data_sharing_of(const GatewayConfig& config) {
+  return config.data_sharing == "off" ? DataSharing::kOff : DataSharing::kAsProfiled;
+}
+
 // joint_states and external_wrench in the namespace; tf absolute (/tf), where tf2 and RViz listen.
 std::optional<Ros2StandardTopics::Options> standard_topics_of(const GatewayConfig& config) {
   Ros2StandardTopics::Options options;
@@ -191,6 +195,7 @@ std::optional<Ros2StandardTopics::Options> standard_topics_of(const GatewayConfi
   options.base_frame = config.base_frame;
   options.ee_frame = config.ee_frame;
   options.wrench_frame = config.wrench_frame;
+  options.data_sharing = data_sharing_of(config);
   return options;
 }
 
@@ -220,6 +225,7 @@ GatewaySetup prepare(const GatewayConfig& config) {
     ingress.standard_topics = standard_topics_of(config);
     ingress.partitions = partitions_of(config);
     ingress.writer_profile = config.writer_profile;
+    ingress.data_sharing = data_sharing_of(config);
     ingress.nominal_period = std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(1.0 / config.expected_rate));
     ingress.restart_threshold_ms = static_cast<std::uint64_t>(config.restart_threshold_ms);
@@ -238,6 +244,7 @@ GatewaySetup prepare(const GatewayConfig& config) {
     egress.type_name = state_type_name(config);
     egress.partitions = partitions_of(config);
     egress.reader_profile = config.reader_profile;
+    egress.data_sharing = data_sharing_of(config);
     for (const auto& destination : config.send_to)
       egress.destinations.push_back(resolve("send-to", destination));
     egress.max_rate_hz = config.egress_rate > 0 ? config.egress_rate : config.expected_rate;
@@ -252,7 +259,7 @@ Gateway::Gateway(const GatewaySetup& setup)
     : config_(setup.config),
       participant_(config_.domain, participant_qos(config_)),
       status_(check_entity_profiles(participant_, config_), status_topic_of(config_), partitions_of(config_),
-              config_.status_profile,
+              config_.status_profile, data_sharing_of(config_),
               config_.ros2 ? std::string(dds::kRos2GatewayStatusType) : std::string()),
       stats_file_(config_.stats_file) {
   if (setup.ingress) {

@@ -5,7 +5,7 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 
 #include "dds/internal/fastdds_compat.hpp"  // is_plain
-#include "gateway/no_reader_filters.hpp"
+#include "gateway/entities.hpp"
 
 namespace rsg::gateway {
 namespace fdds = eprosima::fastdds::dds;
@@ -102,12 +102,16 @@ Ingress::Ingress(dds::Participant& participant, Options options)
   // Should anything below throw, the owners built so far delete their entities.
   publisher_ = dds::own(participant_, participant_.publisher(options_.partitions));
   fdds::Topic* topic = participant_.robot_state_topic(options_.topic, options_.type_name);
-  writer_ = dds::own(*publisher_, create_writer_with_profile(*publisher_, topic, options_.writer_profile),
-                     "the RobotState writer with profile '" + options_.writer_profile + "'");
+  writer_ =
+      dds::own(*publisher_,
+               create_writer_with_profile(*publisher_, topic, options_.writer_profile, options_.data_sharing),
+               "the RobotState writer with profile '" + options_.writer_profile + "'");
   for (const auto& rate : options_.rate_topics) {
     fdds::Topic* rate_topic = participant_.robot_state_topic(rate.topic, options_.type_name);
     rate_writers_.push_back(
-        {dds::own(*publisher_, create_writer_with_profile(*publisher_, rate_topic, options_.writer_profile),
+        {dds::own(*publisher_,
+                  create_writer_with_profile(*publisher_, rate_topic, options_.writer_profile,
+                                             options_.data_sharing),
                   "the writer of --rate-topic '" + rate.topic + "'"),
          Decimator(rate.rate)});
   }

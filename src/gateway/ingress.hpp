@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "gateway/clock.hpp"
+#include "gateway/data_sharing.hpp"
 #include "gateway/decimator.hpp"
 #include "gateway/flight_recorder.hpp"
 #include "gateway/latency_histogram.hpp"
@@ -43,6 +44,7 @@ class Ingress {
     std::string type_name;  ///< "" : rsg::RobotState; else e.g. rsg::dds::kRos2RobotStateType
     std::vector<std::string> partitions;
     std::string writer_profile;
+    DataSharing data_sharing = DataSharing::kAsProfiled;  ///< of every writer (entities.hpp)
     Clock::duration nominal_period{};
     std::uint64_t restart_threshold_ms = 0;
     std::optional<wire::Selection> requested_selection;

@@ -9,7 +9,7 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <stdexcept>
 
-#include "gateway/no_reader_filters.hpp"
+#include "gateway/entities.hpp"
 #include "rsg/error.hpp"
 #include "rsg/wire/eigen.hpp"
 
@@ -101,8 +101,9 @@ Ros2StandardTopics::~Ros2StandardTopics() {
 void Ros2StandardTopics::create(Writer& writer, const std::optional<Output>& output, fdds::TypeSupport type) {
   if (!output) return;
   fdds::Topic* topic = participant_.topic(output->topic, type);
-  writer.writer = dds::own(publisher_, create_writer(publisher_, topic, writer_qos(publisher_)),
-                           "the writer of '" + output->topic + "'");
+  writer.writer =
+      dds::own(publisher_, create_writer(publisher_, topic, writer_qos(publisher_), options_.data_sharing),
+               "the writer of '" + output->topic + "'");
   writer.decimator.emplace(output->decimation);
 }
 

@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "gateway/data_sharing.hpp"
 #include "gateway/decimator.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
@@ -37,10 +38,11 @@ class Ros2StandardTopics {
     std::optional<Output> joint_states;
     std::optional<Output> tf;
     std::optional<Output> external_wrench;
-    std::vector<std::string> joint_names;  ///< 7 names, joint 1 first
-    std::string base_frame;                ///< TF parent: the frame O of O_T_EE
-    std::string ee_frame;                  ///< TF child: the end effector
-    std::string wrench_frame;              ///< frame_id of the wrench (O_F_ext_hat_K is in O)
+    std::vector<std::string> joint_names;                 ///< 7 names, joint 1 first
+    std::string base_frame;                               ///< TF parent: the frame O of O_T_EE
+    std::string ee_frame;                                 ///< TF child: the end effector
+    std::string wrench_frame;                             ///< frame_id of the wrench (O_F_ext_hat_K is in O)
+    DataSharing data_sharing = DataSharing::kAsProfiled;  ///< of every writer (entities.hpp)
 
     bool any() const { return joint_states || tf || external_wrench; }
   };

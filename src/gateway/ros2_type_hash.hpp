@@ -5,9 +5,6 @@
 #pragma once
 
 #include <fastdds/dds/core/policy/QosPolicies.hpp>
-#include <fastdds/dds/subscriber/DataReader.hpp>
-#include <fastdds/dds/subscriber/Subscriber.hpp>
-#include <fastdds/dds/topic/Topic.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -40,18 +37,6 @@ inline void announce_ros2_type_hash(eprosima::fastdds::dds::UserDataQosPolicy& u
   if (hash.empty()) return;
   const std::string text = "typehash=" + std::string(hash) + ";";
   user_data.setValue(std::vector<rsg::dds::rtps::octet>(text.begin(), text.end()));
-}
-
-/// create_datareader_with_profile, with the topic type's hash announced when it has one.
-inline eprosima::fastdds::dds::DataReader* create_reader_with_profile(
-    eprosima::fastdds::dds::Subscriber& subscriber, eprosima::fastdds::dds::Topic* topic,
-    const std::string& profile) {
-  eprosima::fastdds::dds::DataReaderQos qos;
-  if (ros2_type_hash(topic->get_type_name()).empty() ||
-      subscriber.get_datareader_qos_from_profile(profile, qos) != rsg::dds::kOk)
-    return subscriber.create_datareader_with_profile(topic, profile);
-  announce_ros2_type_hash(qos.user_data(), topic->get_type_name());
-  return subscriber.create_datareader(topic, qos);
 }
 
 }  // namespace rsg::gateway

@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "dds/internal/fastdds_compat.hpp"  // rename_type
-#include "gateway/no_reader_filters.hpp"
+#include "gateway/entities.hpp"
 #include "rsg/error.hpp"
 #include "status/status_sample.hpp"
 
@@ -16,15 +16,16 @@ namespace fdds = eprosima::fastdds::dds;
 
 StatusPublisher::StatusPublisher(dds::Participant& participant, const std::string& topic,
                                  const std::vector<std::string>& partitions, const std::string& profile,
-                                 const std::string& type_name)
+                                 DataSharing data_sharing, const std::string& type_name)
     : participant_(participant) {
   publisher_ = dds::own(participant_, participant_.publisher(partitions));
   // TypeSupport takes ownership of the type object it is given.
   fdds::TypeSupport type(new GatewayStatusPubSubType());
   if (!type_name.empty()) dds::internal::rename_type(type, type_name);
   fdds::Topic* status_topic = participant_.topic(topic, type);
-  writer_ = dds::own(*publisher_, create_writer_with_profile(*publisher_, status_topic, profile),
-                     "the GatewayStatus writer with profile '" + profile + "'");
+  writer_ =
+      dds::own(*publisher_, create_writer_with_profile(*publisher_, status_topic, profile, data_sharing),
+               "the GatewayStatus writer with profile '" + profile + "'");
 }
 
 StatusPublisher::~StatusPublisher() = default;  // the owners delete the writer, then the publisher

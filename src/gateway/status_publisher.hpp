@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "gateway/data_sharing.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "status/stats.hpp"
@@ -18,7 +19,7 @@ class StatusPublisher {
   /// `type_name` "" keeps the IDL's name (rsg::GatewayStatus), else e.g. rsg::dds::kRos2GatewayStatusType.
   StatusPublisher(dds::Participant& participant, const std::string& topic,
                   const std::vector<std::string>& partitions, const std::string& profile,
-                  const std::string& type_name = {});
+                  DataSharing data_sharing, const std::string& type_name = {});
   ~StatusPublisher();
   StatusPublisher(const StatusPublisher&) = delete;
   StatusPublisher& operator=(const StatusPublisher&) = delete;

@@ -1,5 +1,5 @@
 // The ROS 2 standard topics' writers are created like every other writer of the gateway
-// (gateway/no_reader_filters.hpp): no reader's content filter runs in them, so no reader can make the
+// (gateway/entities.hpp): no reader's content filter runs in them, so no reader can make the
 // gateway evaluate its expression (docs/operating.md, "rsg's writers evaluate no reader's filter").
 #include <gtest/gtest.h>
 

@@ -115,7 +115,9 @@ def body(h):
     check(plain.poll() is None, f"the plain reader stopped (exit {plain.returncode})")
     lines = h.output("plain").read_text().count("\n")
     check(lines > 1000, f"the plain reader printed only {lines} samples")
+    stop_start = time.monotonic()
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
+    print(f"[dds_attacks] the gateway exited {time.monotonic() - stop_start:.2f} s after SIGTERM", flush=True)
 
 
 if __name__ == "__main__":

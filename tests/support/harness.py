@@ -29,6 +29,25 @@ class TestFailure(Exception):
     pass
 
 
+def thread_dump(pid):
+    """What each thread of a process that does not exit is doing: its name (rsg names its threads),
+    state and kernel wait channel from /proc, and with gdb installed every thread's stack."""
+    lines = []
+    for task in sorted(Path(f"/proc/{pid}/task").glob("*"), key=lambda p: int(p.name)):
+        try:
+            name = (task / "comm").read_text().strip()
+            state = next(l for l in (task / "status").read_text().splitlines() if l.startswith("State:"))
+            wchan = (task / "wchan").read_text().strip()
+        except (OSError, StopIteration):
+            continue
+        lines.append(f"  {task.name} {name}: {state.split(None, 1)[1]}, waiting in {wchan or '-'}")
+    if shutil.which("gdb"):
+        dump = subprocess.run(["gdb", "-p", str(pid), "-batch", "-nx", "-ex", "thread apply all bt 30"],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
+        lines += [l for l in dump.stdout.splitlines() if l.startswith(("Thread ", "#"))]
+    return "\n".join(lines)
+
+
 def check(condition, message):
     if not condition:
         raise TestFailure(message)
@@ -161,6 +180,8 @@ class Harness:
         try:
             return process.wait(timeout=timeout_s)
         except subprocess.TimeoutExpired:
+            print(f"--- {label} (pid {process.pid}) still running after {timeout_s:.0f} s: its threads")
+            print(thread_dump(process.pid))
             raise TestFailure(f"{label} did not exit within {timeout_s:.0f} s")
 
     def stop(self, label, process):

@@ -108,6 +108,7 @@ BAD_VALUES = {
         "--reader-profile": ["--reader-profile", "reader_nonexistent", "--egress-topic", "cmd", "--send-to",
                              "127.0.0.1:9", "--check-config"],
         "--status-profile": ["--status-profile", "writer_nonexistent", "--check-config"],
+        "--data-sharing": ["--data-sharing", "sometimes"],
         "--discovery-server": ["--discovery-server", "x@@y"],
         "--peer": ["--peer", "host:70000"],
     },
