@@ -206,6 +206,8 @@ class GatewayProcess {
         ingress_(wait_for_ingress()) {}
 
   const transport::Endpoint& ingress() const { return ingress_; }
+  /// Waits until the process logs `line` (fails the bench when it exits first or never does).
+  void wait_for_log(const std::string& line) { wait_for_log_line(log_, line, process_); }
   pid_t pid() const { return process_.pid(); }
   /// Its stats file (empty for a relay that writes none).
   const std::filesystem::path& stats() const { return stats_; }
@@ -447,6 +449,7 @@ json run_floor(const BenchOptions& options, std::string_view publisher, std::str
     cyclone_reader.emplace(options, topic, label);
     cyclone_reader->wait_for_writer();
   }
+  if (publisher != "gateway") relay.wait_for_log("relay: writer matched");
 
   FrameSender send(relay.ingress());
   send_paced(0, options.warmup_frames(), options.rate_hz, send);
@@ -472,11 +475,16 @@ json run_relay_role(const BenchOptions& options) {
       participant.robot_state_topic(options.topic), options.writer_profile);
   require(writer != nullptr, "cannot create a writer with profile '" + options.writer_profile + "'");
   RobotState sample;
-  relay_frames([&](const StampBytes& stamp) {
-    std::memcpy(sample.elbow_d().data(), stamp.elbow_d, sizeof(double) * 2);
-    std::memcpy(&sample.time(), stamp.time, sizeof sample.time());
-    writer->write(&sample);
-  });
+  relay_frames(
+      [&](const StampBytes& stamp) {
+        std::memcpy(sample.elbow_d().data(), stamp.elbow_d, sizeof(double) * 2);
+        std::memcpy(&sample.time(), stamp.time, sizeof sample.time());
+        writer->write(&sample);
+      },
+      [&] {
+        fdds::PublicationMatchedStatus status;
+        return writer->get_publication_matched_status(status) == dds::kOk && status.current_count > 0;
+      });
   return {};
 }
 

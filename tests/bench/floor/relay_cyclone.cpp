@@ -17,11 +17,17 @@ int main(int argc, char** argv) {
     const rsg::bench::CycloneTopic dds(argv[1], argv[2]);
     Entity writer(dds_create_writer(dds.participant.get(), dds.topic.get(), nullptr, nullptr), "writer");
     rsg_RobotState sample{};
-    rsg::bench::relay_frames([&](const rsg::bench::StampBytes& stamp) {
-      std::memcpy(sample.elbow_d, stamp.elbow_d, sizeof sample.elbow_d);
-      std::memcpy(&sample.time, stamp.time, sizeof sample.time);
-      dds_write(writer.get(), &sample);
-    });
+    rsg::bench::relay_frames(
+        [&](const rsg::bench::StampBytes& stamp) {
+          std::memcpy(sample.elbow_d, stamp.elbow_d, sizeof sample.elbow_d);
+          std::memcpy(&sample.time, stamp.time, sizeof sample.time);
+          dds_write(writer.get(), &sample);
+        },
+        [&] {
+          dds_publication_matched_status_t status{};
+          return dds_get_publication_matched_status(writer.get(), &status) == DDS_RETCODE_OK &&
+                 status.current_count > 0;
+        });
     return 0;
   } catch (const std::exception& error) {
     std::cerr << "rsg_bench_relay_cyclone: " << error.what() << '\n';

@@ -25,9 +25,11 @@ struct StampBytes {
 inline std::atomic<bool> relay_stop{false};
 
 /// Binds 127.0.0.1:0, logs "frames on UDP 127.0.0.1:PORT" (the bench reads the port from it) and
-/// calls `write(stamp)` for every datagram until SIGTERM/SIGINT.
-template <typename Write>
-void relay_frames(Write write) {
+/// calls `write(stamp)` for every datagram until SIGTERM/SIGINT. Logs "relay: writer matched" once
+/// `writer_matched()` is true: discovery is not symmetric, so the bench waits for the writer's side
+/// too before it sends (a frame written before the writer knows the reader is lost to it).
+template <typename Write, typename Matched>
+void relay_frames(Write write, Matched writer_matched) {
   std::signal(SIGTERM, [](int) { relay_stop = true; });
   std::signal(SIGINT, [](int) { relay_stop = true; });
   transport::UdpSocket socket = transport::UdpSocket::bind(transport::Endpoint::parse("127.0.0.1:0"));
@@ -35,7 +37,12 @@ void relay_frames(Write write) {
   std::fprintf(stderr, "relay: frames on UDP %s -> DDS\n", socket.local_endpoint().to_string().c_str());
   std::vector<std::uint8_t> datagram(wire::kMaxFrameBytes);
   std::ptrdiff_t elbow_d = -1, time = -1;
+  bool matched = false;
   while (!relay_stop) {
+    if (!matched && writer_matched()) {
+      matched = true;
+      std::fprintf(stderr, "relay: writer matched\n");
+    }
     const auto size = socket.receive(datagram, nullptr, std::chrono::milliseconds(100));
     if (!size) continue;
     if (elbow_d < 0) {
