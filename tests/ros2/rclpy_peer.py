@@ -24,6 +24,7 @@ TYPE is pkg/msg/Name. Topic names are ROS names (relative ones resolve in the ro
 """
 import argparse
 import array
+import faulthandler
 import importlib
 import json
 import sys
@@ -327,4 +328,7 @@ def main():
 
 
 if __name__ == "__main__":
+    # A crash inside rclpy or its Fast DDS (a peer's, not rsg's) leaves the Python stack on stderr,
+    # where the harness shows it, instead of only an exit status.
+    faulthandler.enable()
     sys.exit(main())

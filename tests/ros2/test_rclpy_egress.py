@@ -40,7 +40,8 @@ def body(h):
         # that reader acknowledged every message (so it had matched the node too).
         check(h.wait("publisher", publisher, 90) == 0, "the rclpy publisher's messages were not all acknowledged")
         graph = start_peer(h, env, "graph", "graph", "/robot1/robot_state_cmd", "--subscriptions", "--timeout", 30)
-        check(h.wait("graph", graph, 60) == 0, "the graph query failed")
+        status = h.wait("graph", graph, 60)
+        check(status == 0, f"the graph query failed (exit {status})")
         check_egress(h, sink, expected, stats, gateway)
     readers = json.loads(h.output("graph").read_text())["subscriptions"]["/robot1/robot_state_cmd"]
     check(len(readers) == 1, f"{len(readers)} subscriptions of /robot1/robot_state_cmd in the ROS graph")

@@ -61,7 +61,8 @@ def run(h, env, namespace):
     for name in [*peers, "late"]:
         process = dict(h.children)[f"{label}_{name}"]
         check(h.wait(f"{label}_{name}", process, 90) == 0, f"{label}_{name} ended in failure (see its log)")
-    check(h.wait(label + "_graph", graph, 60) == 0, "the graph query failed")
+    status = h.wait(label + "_graph", graph, 60)
+    check(status == 0, f"the graph query failed (exit {status})")
 
     got = read_messages(h, f"{label}_default")
     check(len(got) >= COUNT * 9 // 10, f"the default-QoS subscription got {len(got)} of {COUNT}")
