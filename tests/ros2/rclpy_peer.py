@@ -236,7 +236,7 @@ def graph(args):
 def churn(args):
     from rsg_msgs.msg import RobotState  # noqa: the churned nodes read the gateway's state
     wrong = [0]
-    for index in range(args.count):
+    for index in range(args.first, args.first + args.count):
         context = rclpy.Context()
         rclpy.init(context=context)
         node = rclpy.create_node(f"rsg_churn_{index}", context=context)
@@ -308,6 +308,7 @@ def main():
     info.add_argument("--timeout", type=float, default=30)
     ch = commands.add_parser("churn")
     ch.add_argument("--count", type=int, default=50)
+    ch.add_argument("--first", type=int, default=0, help="index of the first node (its name's number)")
     ch.add_argument("--topic", default="robot_state")
     ch.add_argument("--hold", type=float, default=5)
     ch.add_argument("--filter")

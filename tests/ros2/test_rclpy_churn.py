@@ -8,7 +8,9 @@ subscribers are killed with SIGKILL (they vanish without saying goodbye: the gat
 lease expiry). A reliable keep-all rclpy subscription that stays all along gets every frame, in
 order, equal member by member to what the sim sent; the gateway's frames_published never stands
 still for 1 s while the sim sends, it publishes all 3000 with no write failure, is still running,
-and counts no state reader once every node has left (the killed ones by lease expiry).
+and counts no state reader once every node has left (the killed ones by lease expiry). Should the
+churning process itself crash (its Fast DDS, in destroy_node), a new one churns the nodes still to
+come, at most three times, and the test says so.
 """
 import signal
 import sys
@@ -22,6 +24,7 @@ COUNT = 3000
 RATE = "200"
 NODES = 50
 KILLED = 3
+MAX_PEER_CRASHES = 3
 
 
 def body(h):
@@ -49,6 +52,7 @@ def body(h):
     watcher = threading.Thread(target=watch, daemon=True)
     watcher.start()
     churn = start_peer(h, env, "churn", "churn", "--count", NODES, "--topic", "/robot_state", "--hold", 3)
+    churn_runs = ["churn"]
     victims = [start_peer(h, env, f"victim{i}", "sub", "/robot_state", "rsg_msgs/msg/RobotState", "--timeout", 60)
                for i in range(KILLED)]
     for i, victim in enumerate(victims):
@@ -58,9 +62,26 @@ def body(h):
         victim.send_signal(signal.SIGKILL)
         victim.wait()
 
-    check(h.wait("churn", churn, 150) == 0, "the churning rclpy process failed")
-    churned = (h.dir / "churn.err").read_text().splitlines()
-    started = [line for line in churned if line.startswith("node ")]
+    # The churning peer's own Fast DDS (3.2.3 on Kilted) can crash in destroy_node when a node leaves
+    # while discovery still pairs its endpoints (SIGSEGV in rclpy's destroy_node, seen once in a CI-like
+    # run; docs/operating.md, "A reader deleted while it is being matched"). That is the peer's, not the
+    # gateway's: a new process churns the nodes still to come, at most MAX_PEER_CRASHES times, and the
+    # test says so. Any other failure of the peer fails the test.
+    started = []
+    while True:
+        status = h.wait(churn_runs[-1], churn, 150)
+        churned = (h.dir / f"{churn_runs[-1]}.err").read_text(errors="replace")
+        started += [line for line in churned.splitlines() if line.startswith("node ")]
+        if status == 0:
+            break
+        check(status == -signal.SIGSEGV or "Segmentation fault" in churned,
+              f"the churning rclpy process failed (exit {status})")
+        check(len(churn_runs) <= MAX_PEER_CRASHES, f"the churning rclpy process crashed {len(churn_runs)} times")
+        print(f"[rclpy_churn] the churning rclpy process crashed (exit {status}) after {len(started)} nodes: "
+              "its Fast DDS, not the gateway; the rest in a new process", flush=True)
+        churn_runs.append(f"churn{len(churn_runs)}")
+        churn = start_peer(h, env, churn_runs[-1], "churn", "--first", len(started), "--count", NODES - len(started),
+                           "--topic", "/robot_state", "--hold", 3)
     check(len(started) == NODES, f"{len(started)} of {NODES} nodes started and stopped")
     unmatched = [line for line in started if "matched 0" in line]
     check(not unmatched, f"nodes that never matched the gateway: {unmatched[:3]}")
