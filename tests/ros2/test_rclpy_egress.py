@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 from harness import check, main  # noqa: E402
-from rclpy_common import RosEnv, group_present, hash_hint, start_peer  # noqa: E402
+from rclpy_common import RosEnv, graph_query, group_present, hash_hint, start_peer  # noqa: E402
 from test_ros2_egress import check_egress, command_records, egress_gateway, encode  # noqa: E402
 
 
@@ -39,9 +39,7 @@ def body(h):
         # The node publishes once its publisher matched the gateway's reader and exits 0 only when
         # that reader acknowledged every message (so it had matched the node too).
         check(h.wait("publisher", publisher, 90) == 0, "the rclpy publisher's messages were not all acknowledged")
-        graph = start_peer(h, env, "graph", "graph", "/robot1/robot_state_cmd", "--subscriptions", "--timeout", 30)
-        status = h.wait("graph", graph, 60)
-        check(status == 0, f"the graph query failed (exit {status})")
+        graph_query(h, env, "graph", "/robot1/robot_state_cmd", "--subscriptions", "--timeout", 30)
         check_egress(h, sink, expected, stats, gateway)
     readers = json.loads(h.output("graph").read_text())["subscriptions"]["/robot1/robot_state_cmd"]
     check(len(readers) == 1, f"{len(readers)} subscriptions of /robot1/robot_state_cmd in the ROS graph")

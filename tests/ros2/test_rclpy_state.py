@@ -19,7 +19,7 @@ import json
 import sys
 
 from harness import check, free_udp_port, main, read_json_lines, wait_for_stats  # noqa: E402
-from rclpy_common import RosEnv, check_in_order, hash_hint, read_messages, start_peer, wait_peer_matched
+from rclpy_common import RosEnv, check_in_order, graph_query, hash_hint, read_messages, start_peer, wait_peer_matched
 
 COUNT = 200
 RATE = "200"
@@ -56,13 +56,11 @@ def run(h, env, namespace):
     # Joins after the stream: transient-local gets the writer's history.
     start_peer(h, env, f"{label}_late", "sub", state, "rsg_msgs/msg/RobotState", "--qos", "transient_local",
                "--depth", 10, "--count", 0, "--idle", "3", "--timeout", 60)
-    graph = start_peer(h, env, f"{label}_graph", "graph", state, f"{ns}/gateway_status", "--timeout", 30)
 
     for name in [*peers, "late"]:
         process = dict(h.children)[f"{label}_{name}"]
         check(h.wait(f"{label}_{name}", process, 90) == 0, f"{label}_{name} ended in failure (see its log)")
-    status = h.wait(label + "_graph", graph, 60)
-    check(status == 0, f"the graph query failed (exit {status})")
+    graph_query(h, env, f"{label}_graph", state, f"{ns}/gateway_status", "--timeout", 30)
 
     got = read_messages(h, f"{label}_default")
     check(len(got) >= COUNT * 9 // 10, f"the default-QoS subscription got {len(got)} of {COUNT}")
