@@ -8,7 +8,9 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <initializer_list>
 #include <set>
+#include <string_view>
 
 #include "gateway/source_filter.hpp"
 #include "rsg/dds/ros2.hpp"
@@ -41,6 +43,14 @@ std::string check_range(int value, int low, int high) {
 }
 
 std::string check_not_empty(const std::string& value) { return value.empty() ? "must not be empty" : ""; }
+
+/// Empty when `value` is one of `allowed`, else what is wrong with it.
+std::string check_one_of(const std::string& value, std::initializer_list<std::string_view> allowed) {
+  if (std::ranges::find(allowed, value) != allowed.end()) return {};
+  std::string list;
+  for (const std::string_view name : allowed) list += (list.empty() ? "" : ", ") + std::string(name);
+  return "'" + value + "' is not one of " + list;
+}
 
 // A topic, partition or gateway name: no control character, which would split the log lines, the
 // status and the metrics that show it.
@@ -268,9 +278,7 @@ const std::array kKeys = {
               "per line: time, level, logger, message)",
               &GatewayConfig::log_format,
               [](const GatewayConfig& c) {
-                return c.log_format == "text" || c.log_format == "json"
-                           ? std::string()
-                           : "'" + c.log_format + "' is not one of text, json";
+                return check_one_of(c.log_format, {"text", "json"});
               }},
     ConfigKey{"rt-priority",
               "Run the ingress thread SCHED_FIFO at this priority (1..99) and lock the process's memory "
@@ -352,16 +360,13 @@ const std::array kKeys = {
               [](const GatewayConfig& c) { return check_not_empty(c.reader_profile); }},
     ConfigKey{"status-profile", "XML data writer profile of the status topic", &GatewayConfig::status_profile,
               [](const GatewayConfig& c) { return check_not_empty(c.status_profile); }},
-    ConfigKey{"data-sharing",
-              "auto (as the XML profiles say: rsg's let same-host readers read the samples in shared memory) or "
-              "off (no writer or reader of the gateway shares memory with another process: the choice for a host "
-              "whose local users are not all trusted, docs/security.md)",
-              &GatewayConfig::data_sharing,
-              [](const GatewayConfig& c) {
-                return c.data_sharing == "auto" || c.data_sharing == "off"
-                           ? std::string()
-                           : "'" + c.data_sharing + "' is not one of auto, off";
-              }},
+    ConfigKey{
+        "data-sharing",
+        "auto (as the XML profiles say: rsg's let same-host readers read the samples in shared memory) or "
+        "off (no writer or reader of the gateway shares memory with another process: the choice for a host "
+        "whose local users are not all trusted, docs/security.md)",
+        &GatewayConfig::data_sharing,
+        [](const GatewayConfig& c) { return check_one_of(c.data_sharing, {"auto", "off"}); }},
     ConfigKey{"discovery-server", transport::kDiscoveryServerHelp, &GatewayConfig::discovery_servers,
               [](const GatewayConfig& c) {
                 return check_each(c.discovery_servers, transport::parse_discovery_server);
