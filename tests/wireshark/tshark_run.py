@@ -24,6 +24,14 @@ def tshark_path():
     return path
 
 
+def ports_decoded_by_number():
+    """The UDP ports this tshark hands to a dissector by number (`tshark -G decodes`)."""
+    done = subprocess.run([tshark_path(), "-G", "decodes"], capture_output=True, text=True, timeout=60, env=ENV)
+    if done.returncode != 0:
+        raise AssertionError(f"tshark -G decodes failed ({done.returncode}): {done.stderr}")
+    return {int(row.split("\t")[1]) for row in done.stdout.splitlines() if row.startswith("udp.port\t")}
+
+
 def fields(capture, names, display_filter=None, options=(), dissector=DISSECTOR):
     """One dict per packet: field name -> list of its occurrences (empty when absent)."""
     argv = [tshark_path(), "-n", "-r", str(capture), "-X", f"lua_script:{dissector}", "-T", "fields",
