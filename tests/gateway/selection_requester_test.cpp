@@ -9,7 +9,7 @@ namespace rsg::gateway {
 namespace {
 
 using std::chrono::seconds;
-const Clock::time_point kStart = Clock::time_point() + std::chrono::hours(1);
+const Clock::time_point kFirstRequest = Clock::time_point() + std::chrono::hours(1);
 
 wire::Selection group(std::size_t g) {
   wire::Selection selection;
@@ -32,7 +32,7 @@ TEST(SelectionRequester, AfterThreeUnansweredRequestsWarnsOnceAndAsksEveryTenSec
   // Frames with the robot's default every 100 ms for a minute; the robot never switches.
   std::vector<int> sent_at_second;
   for (int tenth = 0; tenth < 600; ++tenth) {
-    const auto now = kStart + std::chrono::milliseconds(100 * tenth);
+    const auto now = kFirstRequest + std::chrono::milliseconds(100 * tenth);
     if (requester.due(all, now)) {
       ++sent;
       sent_at_second.push_back(tenth / 10);
@@ -57,17 +57,17 @@ TEST(SelectionRequester, AfterThreeUnansweredRequestsWarnsOnceAndAsksEveryTenSec
 TEST(SelectionRequester, AnAnswerAfterTheWarningIsSaidAndRestoresTheFastPace) {
   SelectionRequester requester(group(2));
   const wire::Selection all = wire::Selection::all();
-  for (int s = 0; s < 4; ++s) ASSERT_TRUE(requester.due(all, kStart + seconds(s)));
+  for (int s = 0; s < 4; ++s) ASSERT_TRUE(requester.due(all, kFirstRequest + seconds(s)));
   const test::CapturedLog log;
-  EXPECT_FALSE(requester.due(group(2), kStart + seconds(5)));
+  EXPECT_FALSE(requester.due(group(2), kFirstRequest + seconds(5)));
   EXPECT_NE(
       log.text().find("the robot streams the requested selection group_select=0x04 now, after 4 requests"),
       std::string::npos)
       << log.text();
   EXPECT_EQ(requester.unanswered(), 0u);
   // The robot restarts with its default: asked again at once, then a second later.
-  EXPECT_TRUE(requester.due(all, kStart + seconds(7)));
-  EXPECT_TRUE(requester.due(all, kStart + seconds(8)));
+  EXPECT_TRUE(requester.due(all, kFirstRequest + seconds(7)));
+  EXPECT_TRUE(requester.due(all, kFirstRequest + seconds(8)));
 }
 
 }  // namespace

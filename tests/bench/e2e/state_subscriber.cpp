@@ -14,14 +14,14 @@ namespace rsg::bench {
 namespace fdds = eprosima::fastdds::dds;
 namespace {
 
-constexpr auto kPollInterval = std::chrono::milliseconds(10);
+constexpr auto kPollStep = std::chrono::milliseconds(10);
 
 template <typename Predicate>
 bool poll_until(std::chrono::milliseconds timeout, Predicate done) {
   const auto deadline = Clock::now() + timeout;
   while (!done()) {
     if (Clock::now() >= deadline) return false;
-    std::this_thread::sleep_for(kPollInterval);
+    std::this_thread::sleep_for(kPollStep);
   }
   return true;
 }
