@@ -85,11 +85,10 @@ deps: deps-test
 # debug information), so that `make test` after `make demo` compiles only what the demo did not.
 OPT_FLAGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG" \
              "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG"
-# That tree is also a unity build (CMake's CMAKE_UNITY_BUILD: each target's sources compiled eight to
-# a translation unit), which the two commands meet cold: about a third less compiling for the demo's
-# tools and for the whole tree (docs/development.md). The sanitizer, fuzz, package and Fast DDS
-# 2.14 / 3 trees compile each file alone, so a file that leans on its neighbour's includes still
-# fails in make test and CI (CONTRIBUTING.md, "Build tree").
+# That tree and the sanitizer tree are unity builds (CMake's CMAKE_UNITY_BUILD: each target's sources
+# compiled eight to a translation unit), which the two commands meet cold: about a third less
+# compiling (docs/development.md). The fuzz, package and Fast DDS 2.14 / 3 trees compile each file
+# alone, so a file that leans on its neighbour's includes still fails in CI (CONTRIBUTING.md).
 UNITY_FLAGS := -DCMAKE_UNITY_BUILD=ON
 
 # The product, what make install installs, with only the build and run packages (no npm, Python
@@ -112,7 +111,7 @@ install: build
 # Unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer.
 unit-asan: deps-test
 	cmake -S . -B $(ASAN_BUILD) $(call generator,$(ASAN_BUILD)) -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-g1 -DCMAKE_C_FLAGS_DEBUG=-g1 \
-	      -DRSG_SANITIZE=ON $(CMAKE_COMMON)
+	      -DRSG_SANITIZE=ON $(UNITY_FLAGS) $(CMAKE_COMMON)
 	cmake --build $(ASAN_BUILD) -j $(JOBS) --target unit_tests && echo "unit-asan: $(ASAN_BUILD) built in $$SECONDS s"
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=$(ASAN_OPTIONS) $(PRIVATE_SHM) ctest --output-on-failure -j $(CTEST_JOBS) -L unit 2>&1 | tee ctest.log && \
 	  echo "unit-asan: ctest took $$SECONDS s"
