@@ -86,8 +86,8 @@ deps: deps-test
 OPT_FLAGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG" \
              "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG"
 # That tree and the sanitizer tree are unity builds (CMake's CMAKE_UNITY_BUILD: each target's sources
-# compiled eight to a translation unit), which the two commands meet cold: about a third less
-# compiling (docs/development.md). The fuzz, package and Fast DDS 2.14 / 3 trees compile each file
+# compiled eight to a translation unit), which the two commands meet cold: a tenth to a third less
+# compiling, as measured (docs/development.md). The fuzz, package and Fast DDS 2.14 / 3 trees compile each file
 # alone, so a file that leans on its neighbour's includes still fails in CI (CONTRIBUTING.md).
 UNITY_FLAGS := -DCMAKE_UNITY_BUILD=ON
 

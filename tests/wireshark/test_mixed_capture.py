@@ -24,7 +24,7 @@ def body(h):
         check(subprocess.run(["which", tool], capture_output=True).returncode == 0,
               f"{tool} is not installed (docker/packages.txt lists tshark; run `make deps`)")
     # Ports Wireshark decodes by number (5868 is DTLS's) go to that dissector before any heuristic
-    # runs (docs/wireshark.md), and 17000 is the dissector's own: the robots here use none of them.
+    # runs (docs/raw-leg.md), and 17000 is the dissector's own: the robots here use none of them.
     decoded = tshark_run.ports_decoded_by_number()
     ports = []
     while len(ports) < 3:
