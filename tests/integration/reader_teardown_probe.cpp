@@ -5,7 +5,7 @@
 // most 4 samples and never takes them (KEEP_ALL, 4 at most, whatever the profile says), so Fast
 // DDS refuses the writer's next payload. A data-sharing reader's listener thread then tries that
 // payload again and again, and once the reader is being deleted it never gets past it: the delete
-// joins that thread forever (Fast DDS 2.9 to 3.2; eProsima/Fast-DDS#6490, in no release yet).
+// joins that thread forever (2.9.1, 2.14.5, 3.1.2; eProsima/Fast-DDS#6490, in no release yet).
 // --data-sharing on forces data-sharing on whatever the profile says: the control.
 // Exit status: 0 the delete returned, 3 it had not returned after --wait seconds (the process ends
 // without it), 2 no writer matched or the reader never filled. It prints "matched" once its reader

@@ -1,7 +1,7 @@
 """A gateway's egress reader is deleted at once when the gateway stops, whatever waits for it.
 
-Fast DDS (2.9.1, 2.14.5, 3.1.2 and 3.2.3 alike; eProsima/Fast-DDS#6490, merged July 2026, in no
-release yet) can hang in `delete_datareader` for a data-sharing reader: the reader is marked dead,
+Fast DDS (2.9.1, 2.14.5 and 3.1.2 alike, the three this test runs on; eProsima/Fast-DDS#6490,
+merged July 2026, in no release yet) can hang in `delete_datareader` for a data-sharing reader: the reader is marked dead,
 then its data-sharing listener thread is joined, but that thread is refused the payload it is on
 again and again and never gets past it. Seen in `integration.egress_limits`: the egress gateway
 still deleting its reader 20 s after SIGTERM, one core spinning in
