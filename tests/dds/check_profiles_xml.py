@@ -3,7 +3,7 @@ a strict parser (Python's expat) reads it.
 
 Why: Fast DDS reads profiles with TinyXML-2, which accepts what XML forbids, such as "--" inside a
 comment; a gateway.xml with one (2026-11-29, "--egress-rate" in a comment) loaded in every test
-while `xmllint`, an editor or another DDS's tooling would refuse the file.
+while a conforming XML parser (expat, here) refuses the file.
 
     check_profiles_xml.py DIR
 """

@@ -3,9 +3,9 @@
 //
 // The reader (RobotState on --topic, with the QoS of the XML reader profile --profile) keeps at
 // most 4 samples and never takes them (KEEP_ALL, 4 at most, whatever the profile says), so Fast
-// DDS refuses the writer's next payload. A data-sharing reader's listener thread then tries that
-// payload again and again, and once the reader is being deleted it never gets past it: the delete
-// joins that thread forever (2.9.1, 2.14.5, 3.1.2; eProsima/Fast-DDS#6490, in no release yet).
+// DDS refuses the writer's next payload. Seen on 2.9.1, 2.14.5 and 3.1.2 with data-sharing on: the
+// delete then joins the reader's data-sharing listener thread, which spins and never returns
+// (eProsima/Fast-DDS#6490, in no release yet); without data-sharing the delete returns at once.
 // --data-sharing on forces data-sharing on whatever the profile says: the control.
 // Exit status: 0 the delete returned, 3 it had not returned after --wait seconds (the process ends
 // without it), 2 no writer matched or the reader never filled. It prints "matched" once its reader

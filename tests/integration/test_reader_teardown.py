@@ -1,9 +1,9 @@
-"""A gateway's egress reader is deleted at once when the gateway stops, whatever waits for it.
+"""A reader with the gateway's egress profile is deleted at once, whatever payload waits for it.
 
 Fast DDS (2.9.1, 2.14.5 and 3.1.2 alike, the three this test runs on; eProsima/Fast-DDS#6490,
-merged July 2026, in no release yet) can hang in `delete_datareader` for a data-sharing reader: the reader is marked dead,
-then its data-sharing listener thread is joined, but that thread is refused the payload it is on
-again and again and never gets past it. Seen in `integration.egress_limits`: the egress gateway
+merged July 2026, in no release yet) can hang in `delete_datareader` for a data-sharing reader that
+holds a writer's payload it did not accept: the delete joins the reader's data-sharing listener
+thread, which spins and never returns. Seen in `integration.egress_limits`: the egress gateway
 still deleting its reader 20 s after SIGTERM, one core spinning in
 `DataSharingListener::process_new_data`. The egress reader's profile (`rsg_state_reader`,
 xml_profiles/gateway.xml) now turns data-sharing off.
@@ -29,6 +29,7 @@ def delete_refusing_reader(h, port, stats, label, *flags):
                             "--profile", "rsg_state_reader", "--wait", str(WAIT_S), *flags])
     out = h.output(label)
     wait_for(lambda: "matched" in out.read_text() or probe.poll() is not None, f"{label} to match the writer")
+    check(probe.poll() is None, f"{label} exited {probe.poll()} before its reader matched: {out.read_text()}")
     wait_for_stats(stats, lambda s: s["state_readers"] >= 1, f"the gateway's writer to match {label}")
     check(h.run(f"sim_{label}", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000",
                                  "--count", "20"]) == 0, "rsg_sim failed")
