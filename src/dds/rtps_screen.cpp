@@ -9,7 +9,6 @@ namespace rsg::dds::internal {
 namespace {
 
 using Reason = RtpsScreenReason;
-using namespace rtps_ids;  // the RTPS numbers, read on every line here
 
 /// Little- or big-endian reads within a bounded span: every read is checked by its caller's
 /// length test first, so none of these can see past the span.
@@ -128,16 +127,27 @@ std::optional<std::uint32_t> skip_dheader(const Span& span, std::uint32_t at) no
   return at + 4 + length;
 }
 
-/// PID_TYPE_INFORMATION: an appendable struct of two appendable TypeIdentifierWithDependencies,
-/// each DHEADER within its parent (CVE-2026-49863).
+/// PID_TYPE_INFORMATION: XTypes 1.3's TypeInformation, a mutable struct in XCDR2: a DHEADER, then
+/// members each with an EMHEADER whose length code gives its size (directly, or through the NEXTINT
+/// that follows); every member within the DHEADER (CVE-2026-49863).
 bool type_information_valid(const Span& value) noexcept {
   const auto end = skip_dheader(value, 0);
   if (!end) return false;
-  const Span outer = value.sub(0, *end);
-  const auto minimal_end = skip_dheader(outer, 4);
-  if (!minimal_end) return false;
-  if (*minimal_end == *end) return true;  // "complete" left out: the struct is appendable
-  return skip_dheader(outer, align4(*minimal_end)).has_value();
+  std::uint64_t at = 4;
+  while (at < *end) {
+    if (*end - at < 4) return false;
+    const std::uint32_t length_code = (value.u32(static_cast<std::uint32_t>(at)) >> 28) & 0x7u;
+    at += 4;
+    std::uint64_t size = std::uint64_t{1} << length_code;  // 1, 2, 4 or 8 bytes
+    if (length_code >= 4) {
+      if (*end - at < 4) return false;
+      const std::uint64_t next = value.u32(static_cast<std::uint32_t>(at));
+      size = 4 + (length_code == 6 ? 4 * next : length_code == 7 ? 8 * next : next);
+    }
+    if (size > *end - at) return false;
+    at = (at + size + 3) & ~std::uint64_t{3};
+  }
+  return true;
 }
 
 /// Per-announcement locator counts, one per locator PID.

@@ -7,7 +7,6 @@
 namespace rsg::dds::internal {
 namespace {
 
-using namespace rtps_ids;  // the RTPS numbers
 
 /// How long a participant not heard from keeps its place in the table.
 constexpr std::chrono::seconds kForgetAfter{60};

@@ -308,6 +308,30 @@ TEST(RtpsScreen, StringsDurationsAndLocators) {
                     pl_payload(spdp_parameters(parameter(0x0023, u32s({0x7fffffff, 0xffffffff})))))}));
 }
 
+Bytes from_hex(const std::string& hex) {
+  Bytes out;
+  for (std::size_t i = 0; i + 1 < hex.size(); i += 2)
+    out.push_back(static_cast<std::uint8_t>(std::stoi(hex.substr(i, 2), nullptr, 16)));
+  return out;
+}
+
+// PID_TYPE_INFORMATION as a ROS 2 Kilted publisher (Fast DDS 3.2.2) announces it: a mutable
+// XCDR2 struct, a DHEADER and two members with EMHEADERs.
+TEST(RtpsScreen, TypeInformation) {
+  const std::string kilted =
+      "580000000110005024000000140000"
+      "00f1fd2717da51821d97faaea3821def002c000000ffffffff0400000000000000"
+      "021000502400000014000000f2b757c643cd8a4af3894fe45024370070000000ffffffff0400000000000000";
+  expect_whole(message(
+      {data(kSpdpReader, kSedpPubWriter, pl_payload(spdp_parameters(parameter(0x0075, from_hex(kilted)))))}));
+  Bytes lying = from_hex(kilted);
+  lying[8] = 0x60;  // the first member's NEXTINT past the DHEADER
+  expect_spdp_cut(parameter(0x0075, lying), RtpsScreenReason::kParameterValue);
+  Bytes outer = from_hex(kilted);
+  outer[0] = 0x90;  // the DHEADER past the parameter
+  expect_spdp_cut(parameter(0x0075, outer), RtpsScreenReason::kParameterValue);
+}
+
 TEST(RtpsScreen, ParameterListFraming) {
   Bytes no_sentinel = spdp_parameters();
   no_sentinel.erase(no_sentinel.end() - 4, no_sentinel.end());

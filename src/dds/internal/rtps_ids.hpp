@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-namespace rsg::dds::internal::rtps_ids {
+namespace rsg::dds::internal {
 
 inline constexpr std::uint32_t kHeaderBytes = 20;  // "RTPS", version, vendor, GUID prefix
 inline constexpr std::uint32_t kSubmessageHeaderBytes = 4;
@@ -74,4 +74,4 @@ inline constexpr std::uint32_t kLocatorBytes = 24;  // kind, port, 16-byte addre
 // Built-in entity ids (RTPS 2.5, 9.3.1.4).
 inline constexpr std::uint32_t kSpdpWriter = 0x000100c2, kSpdpReader = 0x000100c7;
 
-}  // namespace rsg::dds::internal::rtps_ids
+}  // namespace rsg::dds::internal
