@@ -155,8 +155,9 @@ int main(int argc, char** argv) {
     rsg::gateway::check_profile_files(config);
     if (command.check_only) {
       rsg::gateway::check_entity_profiles_offline(config);
-      rsg::gateway::check_bindings(setup);  // last: what a start does first with the configuration
-      std::fputs(rsg::gateway::describe_setup(setup, command.config_file).c_str(), stdout);
+      // Last: what a start does first with the configuration.
+      const std::vector<std::string> notes = rsg::gateway::check_bindings(setup, command.config_file);
+      std::fputs(rsg::gateway::describe_setup(setup, command.config_file, notes).c_str(), stdout);
       return kExitOk;
     }
     // SIGUSR1 asks for a flight-recorder dump: the loop takes it when it sees `dump`. SIGHUP's

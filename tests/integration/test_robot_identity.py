@@ -48,8 +48,9 @@ def body(h):
           "rsg_state_other_writers is not 1 on robot1's /metrics")
     print(f"[{h.name}] same partition: both gateways count 1 other writer; robot1's /readyz: {text.strip()!r}")
 
+    # 2000 samples: 5 s of both robots, time for discovery to show the reader both programs.
     echo = h.start("echo", [h.binary("rsg_echo"), "--domain", str(h.domain), "--partition", "robot1",
-                            "--json", "--count", "400", "--timeout", "30"])
+                            "--json", "--count", "2000", "--timeout", "30"])
     wait_for(lambda: "2 programs write 'robot_state' in partition 'robot1'" in stderr_of(h, "echo"),
              "rsg_echo's warning about two robots in its partition")
     check(h.wait("echo", echo, 45) == 0, f"rsg_echo failed: {stderr_of(h, 'echo')[-500:]}")

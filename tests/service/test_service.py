@@ -275,6 +275,11 @@ class Run:
         check(bound, f"{UNIT} was active before its UDP port {self.port} was bound")
         check(stats is not None, f"{UNIT} was active before its stats file {STATS} was written")
         check(self.box.show(UNIT, "Type") == "notify", f"{UNIT} is not Type=notify")
+        # The memory bound and the restart policy (never given up) as systemd read them.
+        memory_max = self.box.show(UNIT, "MemoryMax")
+        check(memory_max.isdigit(), f"{UNIT}'s MemoryMax is {memory_max!r}, not a bound")
+        check(self.box.show(UNIT, "StartLimitIntervalUSec") in ("0", "0s"),
+              f"{UNIT} has a start limit: {self.box.show(UNIT, 'StartLimitIntervalUSec')}")
         status = wait_for(lambda: self.box.show(UNIT, "StatusText"), "the gateway's STATUS= line", timeout_s=10)
         # The stats file: readable by the group rsg (the unit's Group=), by no other user. setpriv
         # runs as IDs no user has, so that the users and groups stay as they were for `purge`.

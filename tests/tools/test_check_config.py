@@ -28,8 +28,9 @@ import socket
 import subprocess
 import sys
 import tempfile
+import time
 
-from test_domain import test_port
+from test_domain import test_domain, test_port
 
 failures = []
 
@@ -97,6 +98,7 @@ def main():
         config = os.path.join(tmp, "gateway.yaml")
         with open(config, "w", encoding="utf-8") as out:
             out.write(f"listen: {listen}\nmetrics: {metrics}\npartition: robot1\nlog-level: WARN\n"
+                      f"domain: {test_domain()}\n"
                       f"profiles: [{profiles_dir}, {extra}]\nwriter-profile: check_config_writer\n"
                       f"rate-topic: [robot_state_50hz:50]\nstats-file: {tmp}/stats.json\n")
 
@@ -117,11 +119,32 @@ def main():
                                          "--writer-profile", "check_config_writer", "--check"])
         check(status == 0 and "configuration OK" in out, f"--check with two --profiles: exit {status} ({err.strip()!r})")
 
-        # Ports a start cannot have: exit 1 for the check as for the start, with the start's line.
+        # The running gateway of this very file holds its ports (the operator checks before a
+        # restart): not a failure, said.
+        running = subprocess.Popen([gateway, "--config", config], stdin=subprocess.DEVNULL,
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        try:
+            for _ in range(300):
+                if os.path.exists(os.path.join(tmp, "stats.json")) or running.poll() is not None:
+                    break
+                time.sleep(0.1)
+            check(running.poll() is None, f"the gateway of {config} did not start: {running.stderr.read()!r}")
+            status, out, err = run(gateway, ["--config", config, "--check-config"])
+            check(status == 0 and f"UDP {listen} is held by the running rsg_gateway of this configuration (pid "
+                  f"{running.pid})" in out and f"TCP {metrics} is held by the running rsg_gateway" in out,
+                  f"--check-config beside its own running gateway: exit {status}: {out!r} {err!r}")
+        finally:
+            running.terminate()
+            running.wait(timeout=30)
+
+        # Ports a start cannot have: exit 1 for the check as for the start, with the start's line
+        # (and, for the check, who holds the port).
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as udp:
             udp.bind(("127.0.0.1", int(listen.rsplit(":", 1)[1])))
             expect_both(gateway, ["--listen", listen], 1, f"cannot bind UDP {listen}: Address already in use",
                         "--listen on a port in use")
+            status, _, err = run(gateway, ["--listen", listen, "--check-config"])
+            check(f"(held by pid {os.getpid()}: " in err, f"the check does not name this test as the holder: {err!r}")
         with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as tcp:
             tcp.bind(("127.0.0.1", int(metrics.rsplit(":", 1)[1])))
             tcp.listen(1)
