@@ -159,7 +159,8 @@ std::vector<std::string> check_bindings(const GatewaySetup& setup, const std::st
 
 void check_profile_files(const GatewayConfig& config) {
   constexpr std::string_view kFile = "file://";
-  for (const auto& property : profile_participant_qos(config).properties().properties()) {
+  const auto qos = profile_participant_qos(config);  // held: the loop walks into it
+  for (const auto& property : qos.properties().properties()) {
     const std::string& value = property.value();
     if (!value.starts_with(kFile)) continue;
     const std::filesystem::path path = value.substr(kFile.size());

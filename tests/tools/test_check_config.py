@@ -128,7 +128,10 @@ def main():
                 if os.path.exists(os.path.join(tmp, "stats.json")) or running.poll() is not None:
                     break
                 time.sleep(0.1)
-            check(running.poll() is None, f"the gateway of {config} did not start: {running.stderr.read()!r}")
+            if running.poll() is not None:
+                check(False, f"the gateway of {config} exited {running.returncode}: {running.stderr.read()!r}")
+            check(os.path.exists(os.path.join(tmp, "stats.json")), f"the gateway of {config} wrote no stats file "
+                  f"in 30 s: {os.listdir(tmp)}")
             status, out, err = run(gateway, ["--config", config, "--check-config"])
             check(status == 0 and f"UDP {listen} is held by the running rsg_gateway of this configuration (pid "
                   f"{running.pid})" in out and f"TCP {metrics} is held by the running rsg_gateway" in out,
