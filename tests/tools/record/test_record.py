@@ -78,7 +78,8 @@ SELECTIONS = ["--every", "1:q,dq,time", "--every", "3:g0", "--every", "10:all"]
 def set_files(h, stem):
     """The files of a numbered set (--split-size, --trigger), oldest first: their names sort by time
     (STEM_<run's start>_<index>.mcap)."""
-    return sorted(h.dir.glob(f"{stem}_*.mcap"))
+    name = re.compile(rf"{re.escape(stem)}_\d{{8}}T\d{{6}}\.\d{{3}}Z_\d{{6}}\.mcap")
+    return sorted(path for path in h.dir.glob(f"{stem}_*.mcap") if name.fullmatch(path.name))
 
 
 def index_of(path):
@@ -528,7 +529,6 @@ def restart(h):
     time.sleep(1.0)
     check(h.stop("record1", first) == 0, f"the first recorder did not exit 0: {stderr_of(h, 'record1')}")
     run1 = set_files(h, "robot")
-    run1 = [path for path in run1 if path != legacy]
     stamps1 = {path.stem.rsplit("_", 1)[0] for path in run1}
     check(len(run1) == 3 and len(stamps1) == 1, f"the first run kept {[p.name for p in run1]}")
     check(not legacy.exists() and f"removed {legacy} (--max-files)" in stderr_of(h, "record1"),
