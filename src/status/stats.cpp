@@ -28,7 +28,6 @@ std::string to_json(const GatewayStats& stats) {
       {"state_readers", stats.state_readers},
       {"egress_writers", stats.egress_writers},
       {"standard_readers", stats.standard_readers},
-      {"other_state_writers", stats.other_state_writers},
       {"lost", stats.sequence.lost},
       {"duplicated", stats.sequence.duplicated},
       {"reordered", stats.sequence.reordered},

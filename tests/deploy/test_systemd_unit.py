@@ -18,7 +18,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-from harness import TestFailure, check, free_tcp_port, free_udp_port, main, read_json, wait_for_stats  # noqa: E402
+from harness import TestFailure, check, free_tcp_port, free_udp_port, main, wait_for, wait_for_stats  # noqa: E402
+from metrics_support import http_get, parse_samples, value_of  # noqa: E402
 
 DEPLOY = Path(__file__).resolve().parents[2] / "deploy" / "systemd"
 MAX_EXPOSURE = 2.0
@@ -87,6 +88,12 @@ def body(h):
     two_robots(h, lines)
 
 
+def other_writers(metrics):
+    """rsg_state_other_writers of the gateway on TCP port `metrics`."""
+    _, text = http_get(metrics, "/metrics")
+    return value_of(parse_samples(text), "rsg_state_other_writers")
+
+
 def exec_start(lines, instance, gateway_bin):
     """The unit's ExecStart= for `instance`, with this build's binary."""
     line = next(line for line in lines if line.startswith("ExecStart="))
@@ -123,30 +130,29 @@ def two_robots(h, lines):
         running = []
         for robot in ("robot1", "robot2"):
             argv = [word.replace("/etc/rsg/", f"{etc}/") for word in exec_start(lines, robot, gateway_bin)]
-            port = free_udp_port()
+            port, metrics = free_udp_port(), free_tcp_port()
             stats = h.dir / f"{robot}-{kept_partition}.stats.json"
             (h.dir / f"pcap-{robot}-{kept_partition}").mkdir()
             process = h.start(f"{robot}-{kept_partition}", [
                 *argv, "--domain", str(h.domain), "--listen", f"127.0.0.1:{port}", "--allow-from", "127.0.0.1",
-                "--metrics", f"127.0.0.1:{free_tcp_port()}", "--stats-file", str(stats),
+                "--metrics", f"127.0.0.1:{metrics}", "--stats-file", str(stats),
                 "--pcap-dir", str(h.dir / f"pcap-{robot}-{kept_partition}")])
             sim = h.start(f"sim-{robot}-{kept_partition}", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}",
                                                             "--rate", "200", "--duration", "60"])
-            running.append((robot, process, sim, stats))
-        for robot, process, sim, stats in running:
+            running.append((robot, process, sim, stats, metrics))
+        for robot, process, sim, stats, metrics in running:
             wait_for_stats(stats, lambda s: s["link_up"], f"{robot}'s link ({label})")
         if kept_partition:
-            for robot, process, sim, stats in running:
-                wait_for_stats(stats, lambda s: s["other_state_writers"] == 1,
-                               f"the control: {robot} to see the other robot's writer in partition robot1")
+            for robot, process, sim, stats, metrics in running:
+                wait_for(lambda: other_writers(metrics) == 1,
+                         f"the control: {robot} to see the other robot's writer in partition robot1")
         else:
             # Discovery has had the time the control needs to see the other writer (both linked up,
             # the first gateway's writer announced before the second started).
             wait_for_stats(running[1][3], lambda s: s["frames_published"] > 400, "robot2 to stream 2 s")
-            for robot, process, sim, stats in running:
-                check(read_json(stats)["other_state_writers"] == 0, f"{robot} from a copied file sees another "
-                      f"robot in its partition: {read_json(stats)}")
-        for robot, process, sim, stats in running:
+            for robot, process, sim, stats, metrics in running:
+                check(other_writers(metrics) == 0, f"{robot} from a copied file sees another robot in its partition")
+        for robot, process, sim, stats, metrics in running:
             sim.kill()
             check(h.stop(f"{robot}-{kept_partition}", process) == 0, f"{robot} ({label}) did not exit 0")
         print(f"two robots, {label}: " + ("both say another robot writes in partition robot1" if kept_partition
