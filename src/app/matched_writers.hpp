@@ -8,6 +8,12 @@
 //   rsg_echo: warning: a writer of 'robot_state' (type 'rsg::RobotState') exists in partition
 //             'robot2': another partition (--partition robot2)
 //
+// and, when writers of more than one program (two robots' gateways) write the topic in one
+// partition, that the samples are mixed:
+//
+//   rsg_echo: warning: 2 programs write 'robot_state' in partition 'robot1': more than one robot's
+//             gateway (or a replay) in one partition, so this reader gets their samples interleaved...
+//
 // Discovery is not symmetric: a gateway may count a reader (and send to it) before that reader
 // knows the gateway, and a volatile reader misses what is sent in between. The line is the
 // reader's side: an operator learns the tool sees a gateway at all (a wrong domain, partition or
@@ -53,6 +59,16 @@ class MatchedWriters {
       writers_ = matched.current_count;
       ever_matched_ |= writers_ > 0;
       spdlog::info("matched {} {} of '{}'", writers_, writers_ == 1 ? "writer" : "writers", topic_);
+    }
+    if (writers_ <= 1) mixed_said_ = false;  // said again should it happen again
+    if (directory_ != nullptr && writers_ > 1 && !mixed_said_ && now >= next_mixed_check_) {
+      // Discovery's view of the writers may lag the match by a moment: looked at once a second
+      // while more than one writer is matched, until it is said.
+      next_mixed_check_ = now + std::chrono::seconds(1);
+      for (const std::string& line : dds::explain_mixed_writers(wanted(reader), directory_->writers())) {
+        spdlog::warn("{}", line);
+        mixed_said_ = true;
+      }
     }
     if (now - start_ >= kExplainAfter) explain_if_unmatched(reader);
     if (directory_ != nullptr && ever_matched_ && writers_ > 0 && !sampled_ && !silence_said_ &&
@@ -107,6 +123,8 @@ class MatchedWriters {
   bool explained_ = false;
   bool sampled_ = false;
   bool silence_said_ = false;
+  bool mixed_said_ = false;  // more than one robot's writers in a partition: warned
+  std::chrono::steady_clock::time_point next_mixed_check_;
 };
 
 }  // namespace rsg::app

@@ -20,6 +20,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <cctype>
 #include <exception>
 #include <memory>
 #include <optional>
@@ -64,6 +65,20 @@ inline void init_logging(std::string_view tool) {
 /// For a long-running process once it has started (rsg_gateway): each line also carries its time
 /// and level, "[2026-11-24 23:31:50.262] [rsg_gateway] [info] ...", for a log read afterwards.
 inline void log_with_timestamps() { spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%l] %v"); }
+
+/// `--log-level LEVEL` (trace, debug, info, warn, error, off; any case), as rsg_gateway's: sets the
+/// level of what the tool logs as soon as the flag is parsed.
+inline void add_log_level_option(CLI::App& app) {
+  app.add_option_function<std::string>(
+         "--log-level",
+         [](const std::string& level) {
+           std::string lower = level;
+           for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+           spdlog::set_level(spdlog::level::from_str(lower));
+         },
+         "What to log: trace, debug, info, warn, error or off (default info)")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}, CLI::ignore_case));
+}
 
 /// Adds to every unsigned option of `app`, its option groups and subcommands a check that the value
 /// is not negative: CLI11 2.1 converts "-1" to the largest unsigned value without a word.

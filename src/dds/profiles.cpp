@@ -7,11 +7,11 @@
 #include <cstdlib>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/log/Log.hpp>
-#include <fastdds/dds/log/StdoutErrConsumer.hpp>
 #include <stdexcept>
 #include <vector>
 
 #include "dds/internal/fastdds_compat.hpp"
+#include "dds/internal/fastdds_log.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::dds {
@@ -19,14 +19,13 @@ namespace {
 
 // Fast DDS logs through its own consumers, by default to stdout, where a tool's output goes (rsg_echo
 // --json, rsg_frame), and from a thread of its own, after whatever the caller printed meanwhile.
-// Its warnings and errors go to stderr here, like everything else a program says.
+// Its warnings and errors go to stderr here, like everything else a program says, without terminal
+// colour codes unless stderr is a terminal (internal/fastdds_log.hpp).
 void fastdds_log_to_stderr() {
   static const bool done = [] {
     namespace fdds = eprosima::fastdds::dds;
-    auto consumer = std::make_unique<fdds::StdoutErrConsumer>();
-    consumer->stderr_threshold(fdds::Log::Kind::Warning);
     fdds::Log::ClearConsumers();
-    fdds::Log::RegisterConsumer(std::move(consumer));
+    fdds::Log::RegisterConsumer(internal::StderrLogConsumer::for_stderr());  // colour on a terminal only
     return true;
   }();
   (void)done;

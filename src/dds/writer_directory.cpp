@@ -3,6 +3,7 @@
 #include <fnmatch.h>
 
 #include <algorithm>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <map>
 #include <mutex>
@@ -42,8 +43,9 @@ class WriterDirectory::Listener final : public fdds::DomainParticipantListener {
  private:
   void update(bool removed, const rtps::GUID_t& guid, std::string topic, std::string type,
               std::vector<std::string> partitions) {
-    std::ostringstream key;
+    std::ostringstream key, participant;
     key << guid;
+    participant << guid.guidPrefix;
     const std::lock_guard lock(mutex_);
     if (removed) {
       writers_.erase(key.str());
@@ -51,7 +53,7 @@ class WriterDirectory::Listener final : public fdds::DomainParticipantListener {
     }
     auto [entry, inserted] = writers_.try_emplace(key.str(), next_, DiscoveredWriter{});
     if (inserted) ++next_;
-    entry->second.second = {std::move(topic), std::move(type), std::move(partitions)};
+    entry->second.second = {std::move(topic), std::move(type), std::move(partitions), participant.str()};
   }
 
   mutable std::mutex mutex_;
@@ -131,7 +133,12 @@ std::vector<std::string> explain_no_writer(const WantedWriter& wanted,
   std::vector<DiscoveredWriter> said;
   std::vector<std::string> other_topics;
   for (const DiscoveredWriter& writer : seen) {
-    if (std::find(said.begin(), said.end(), writer) != said.end()) continue;
+    // One line per topic, type and partitions, however many participants write them.
+    const auto same_stream = [&writer](const DiscoveredWriter& other) {
+      return other.topic == writer.topic && other.type == writer.type &&
+             other.partitions == writer.partitions;
+    };
+    if (std::any_of(said.begin(), said.end(), same_stream)) continue;
     const bool same_topic = writer.topic == wanted.topic;
     const bool related = same_topic || writer.type == wanted.type ||
                          last_component(writer.topic) == last_component(wanted.topic);
@@ -167,6 +174,43 @@ std::vector<std::string> explain_no_writer(const WantedWriter& wanted,
     lines.push_back(std::move(line));
   }
   return lines;
+}
+
+std::vector<std::string> explain_mixed_writers(const WantedWriter& wanted,
+                                               const std::vector<DiscoveredWriter>& seen) {
+  // The participants writing the topic, per partition list the reader matches.
+  std::map<std::vector<std::string>, std::vector<std::string>> participants;
+  for (const DiscoveredWriter& writer : seen) {
+    if (writer.topic != wanted.topic || !partitions_match(writer.partitions, wanted.partitions)) continue;
+    auto& list = participants[writer.partitions];
+    if (std::find(list.begin(), list.end(), writer.participant) == list.end())
+      list.push_back(writer.participant);
+  }
+  std::vector<std::string> lines;
+  for (const auto& [partitions, list] : participants)
+    if (list.size() > 1)
+      lines.push_back(std::to_string(list.size()) + " programs write '" + wanted.topic + "' in " +
+                      describe_partitions(partitions) +
+                      ": more than one robot's gateway (or a replay) in one partition, so this reader gets "
+                      "their samples interleaved; give each robot its own partition (rsg-gateway@NAME "
+                      "takes NAME unless its file sets one)");
+  return lines;
+}
+
+std::size_t count_other_writers(const std::string& topic, const std::vector<std::string>& partitions,
+                                const std::string& own_participant,
+                                const std::vector<DiscoveredWriter>& seen) {
+  return static_cast<std::size_t>(
+      std::count_if(seen.begin(), seen.end(), [&](const DiscoveredWriter& writer) {
+        return writer.topic == topic && writer.participant != own_participant &&
+               partitions_match(writer.partitions, partitions);
+      }));
+}
+
+std::string participant_key(const fdds::DomainParticipant& participant) {
+  std::ostringstream key;
+  key << participant.guid().guidPrefix;
+  return key.str();
 }
 
 }  // namespace rsg::dds

@@ -490,6 +490,18 @@ std::string assign(GatewayConfig& config, const ConfigKey::Member& member, const
 
 int line_of(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1; }
 
+// "topic robot": a key, a space and a value, the ':' forgotten: the hint, when the first word is a
+// key (or nearly one).
+std::optional<std::string> missing_colon_hint(const std::string& text) {
+  const auto space = text.find_first_of(" \t");
+  if (space == std::string::npos || space == 0) return std::nullopt;
+  const std::string word = text.substr(0, space);
+  const ConfigKey* key = find_key(word);
+  const std::optional<std::string_view> nearest = key ? std::optional(key->name) : nearest_key(word);
+  if (!nearest) return std::nullopt;
+  return "not a 'key: value' line (a missing ':' after '" + std::string(*nearest) + "'?)";
+}
+
 }  // namespace
 
 std::span<const ConfigKey> config_keys() { return kKeys; }
@@ -499,7 +511,12 @@ ConfigResult parse_gateway_config(std::string_view yaml_text, const GatewayConfi
     const YAML::Node root = YAML::Load(std::string(yaml_text));
     GatewayConfig config = defaults;
     if (root.IsNull()) return config;  // an empty file: nothing to change
-    if (!root.IsMap()) return ConfigError{line_of(root.Mark()), "expected a mapping of 'key: value' lines"};
+    if (!root.IsMap()) {
+      if (root.IsScalar())
+        if (auto hint = missing_colon_hint(root.Scalar()))
+          return ConfigError{line_of(root.Mark()), std::move(*hint)};
+      return ConfigError{line_of(root.Mark()), "expected a mapping of 'key: value' lines"};
+    }
 
     std::set<std::string, std::less<>> seen;
     for (const auto& entry : root) {
@@ -508,6 +525,8 @@ ConfigResult parse_gateway_config(std::string_view yaml_text, const GatewayConfi
       const std::string& name = entry.first.Scalar();
       const ConfigKey* key = find_key(name);
       if (!key) {
+        // "topic robot" on the last line is read as a key without a value, not as an error.
+        if (auto hint = missing_colon_hint(name)) return ConfigError{line, std::move(*hint)};
         if (const auto nearest = nearest_key(name))
           return ConfigError{line,
                              "unknown key '" + name + "': did you mean '" + std::string(*nearest) + "'?"};
@@ -548,6 +567,29 @@ std::optional<std::string_view> nearest_key(std::string_view name) {
   // A third of the name may be wrong ("lissten", "expected_rates"), never a different word.
   if (best == nullptr || best_distance > std::max<std::size_t>(1, best->name.size() / 3)) return std::nullopt;
   return best->name;
+}
+
+std::variant<GatewayConfig, std::string> instance_defaults(std::string_view name) {
+  if (name.empty() || name == "." || name == ".." || name.find('/') != std::string_view::npos)
+    return "--instance: '" + std::string(name) + "' cannot name a directory (rsg-gateway@NAME's NAME)";
+  GatewayConfig defaults;
+  defaults.partition = name;
+  defaults.stats_file = std::string(kUnitRuntimeRoot) + "/" + std::string(name) + "/stats.json";
+  defaults.pcap_dir = std::string(kUnitStateRoot) + "/" + std::string(name);
+  return defaults;
+}
+
+std::optional<std::string_view> unit_directory_kind(std::string_view dir) {
+  while (dir.size() > 1 && dir.ends_with('/')) dir.remove_suffix(1);
+  // One component below the root: what RuntimeDirectory=rsg/%i and StateDirectory=rsg/%i create.
+  const auto below = [dir](std::string_view root) {
+    if (!dir.starts_with(root) || dir.size() <= root.size() + 1 || dir[root.size()] != '/') return false;
+    const std::string_view name = dir.substr(root.size() + 1);
+    return name != "." && name != ".." && name.find('/') == std::string_view::npos;
+  };
+  if (below(kUnitRuntimeRoot)) return "RuntimeDirectory=";
+  if (below(kUnitStateRoot)) return "StateDirectory=";
+  return std::nullopt;
 }
 
 std::optional<std::string> check_config(const GatewayConfig& config) {

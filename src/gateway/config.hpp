@@ -162,6 +162,22 @@ ConfigResult parse_gateway_config(std::string_view yaml_text, const GatewayConfi
 /// Returns what is wrong, or nothing.
 std::optional<std::string> check_config(const GatewayConfig& config);
 
+/// The directories the systemd unit rsg-gateway@NAME creates at its start (RuntimeDirectory=rsg/%i,
+/// StateDirectory=rsg/%i in deploy/systemd/rsg-gateway@.service; deploy.systemd_unit checks that
+/// the unit says so): /run/rsg/NAME and /var/lib/rsg/NAME.
+inline constexpr std::string_view kUnitRuntimeRoot = "/run/rsg";
+inline constexpr std::string_view kUnitStateRoot = "/var/lib/rsg";
+
+/// The defaults of the instance `name` of the unit (`--instance NAME`), under what its file and
+/// flags set: partition NAME, stats-file /run/rsg/NAME/stats.json, pcap-dir /var/lib/rsg/NAME. So a
+/// copy of robot1.yaml that does not set them runs robot2 in a partition and directories of its own.
+/// Returns what is wrong with `name` instead when it cannot be a directory's name.
+std::variant<GatewayConfig, std::string> instance_defaults(std::string_view name);
+
+/// Which unit directory `dir` is, when it is one the unit creates at start ("RuntimeDirectory="
+/// for /run/rsg/NAME, "StateDirectory=" for /var/lib/rsg/NAME), else nothing.
+std::optional<std::string_view> unit_directory_kind(std::string_view dir);
+
 /// The spdlog level name of `log-level` (given in any case: "WARN" is "warn"); assumes a checked config.
 std::string log_level_name(const GatewayConfig& config);
 

@@ -19,6 +19,7 @@
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/ros2.hpp"
+#include "rsg/dds/writer_directory.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::gateway {
@@ -54,13 +55,25 @@ double unix_now_s() {
 }
 
 // A directory the gateway will write into must exist and be writable: said at start-up, naming the
-// flag, the file and errno, instead of a warning at every write.
-void check_writable_dir(const std::string& flag, const std::filesystem::path& dir, const std::string& file) {
+// flag, the file and errno, instead of a warning at every write. A check (--check-config) accepts a
+// missing directory that the unit creates when it starts (/run/rsg/NAME, /var/lib/rsg/NAME): an
+// operator checks while the unit is stopped, when they do not exist.
+void check_writable_dir(const std::string& flag, const std::filesystem::path& dir, const std::string& file,
+                        PrepareFor purpose) {
   const std::filesystem::path where = dir.empty() ? std::filesystem::path(".") : dir;
   std::error_code error;
-  if (!std::filesystem::exists(where, error))
+  const std::optional<std::string_view> unit_creates = unit_directory_kind(where.string());
+  if (!std::filesystem::exists(where, error)) {
+    if (purpose == PrepareFor::kCheck && unit_creates) return;
+    const std::string hint =
+        unit_creates
+            ? "the unit rsg-gateway@NAME creates it with its " + std::string(*unit_creates) +
+                  " when it starts; started otherwise, create it first"
+            : std::string("create it first, e.g. ") +
+                  (flag == "stats-file" ? "RuntimeDirectory=" : "StateDirectory=") + " under systemd";
     throw InputError("--" + flag + ": cannot write '" + file + "': directory '" + where.string() +
-                     "': " + errno_text(ENOENT) + " (create it first, e.g. RuntimeDirectory= under systemd)");
+                     "': " + errno_text(ENOENT) + " (" + hint + ")");
+  }
   if (!std::filesystem::is_directory(where, error))
     throw InputError("--" + flag + ": cannot write '" + file + "': '" + where.string() +
                      "': " + errno_text(ENOTDIR));
@@ -69,15 +82,16 @@ void check_writable_dir(const std::string& flag, const std::filesystem::path& di
                      "': " + errno_text(errno));
 }
 
-void check_output_files(const GatewayConfig& config) {
+void check_output_files(const GatewayConfig& config, PrepareFor purpose) {
   if (!config.stats_file.empty()) {
     const std::filesystem::path file = config.stats_file;
     std::error_code error;
     if (std::filesystem::is_directory(file, error))
       throw InputError("--stats-file: '" + config.stats_file + "' is a directory: " + errno_text(EISDIR));
-    check_writable_dir("stats-file", file.parent_path(), config.stats_file);
+    check_writable_dir("stats-file", file.parent_path(), config.stats_file, purpose);
   }
-  if (config.pcap_ring > 0) check_writable_dir("pcap-dir", config.pcap_dir, config.pcap_dir + "/*.pcap");
+  if (config.pcap_ring > 0)
+    check_writable_dir("pcap-dir", config.pcap_dir, config.pcap_dir + "/*.pcap", purpose);
 }
 
 // The --profiles files or directories, for messages: "a.xml, b/" (or rsg's directory).
@@ -90,6 +104,8 @@ InputError no_profile(const GatewayConfig& config, const std::string& flag, cons
                       const std::string& name) {
   return InputError("--" + flag + ": no " + kind + " profile named '" + name + "' in " + profiles_of(config));
 }
+
+}  // namespace
 
 // The participant profile's QoS, with systemd's credentials directory in its properties
 // (credentials.hpp); looked up before anything exists, and again to create the participant.
@@ -104,6 +120,8 @@ fdds::DomainParticipantQos profile_participant_qos(const GatewayConfig& config) 
         "participant profile '" + config.participant_profile + "', property " + property.name());
   return qos;
 }
+
+namespace {
 
 void load_and_check_profiles(const GatewayConfig& config) {
   try {
@@ -201,10 +219,10 @@ std::optional<Ros2StandardTopics::Options> standard_topics_of(const GatewayConfi
 
 }  // namespace
 
-GatewaySetup prepare(const GatewayConfig& config) {
+GatewaySetup prepare(const GatewayConfig& config, PrepareFor purpose) {
   if (auto problem = check_config(config)) throw InputError(*problem);
 
-  check_output_files(config);
+  check_output_files(config, purpose);
 
   GatewaySetup setup{config, std::nullopt, std::nullopt, std::nullopt};
   if (config.has_ingress()) {
@@ -257,12 +275,14 @@ GatewaySetup prepare(const GatewayConfig& config) {
 
 Gateway::Gateway(const GatewaySetup& setup)
     : config_(setup.config),
-      participant_(config_.domain, participant_qos(config_)),
+      participant_(config_.domain, participant_qos(config_), writers_.listener()),
       status_(check_entity_profiles(participant_, config_), status_topic_of(config_), partitions_of(config_),
               config_.status_profile, data_sharing_of(config_),
               config_.ros2 ? std::string(dds::kRos2GatewayStatusType) : std::string()),
       stats_file_(config_.stats_file) {
+  own_participant_ = dds::participant_key(*participant_.get());
   if (setup.ingress) {
+    state_topic_ = setup.ingress->topic;
     ingress_.emplace(participant_, *setup.ingress);
     if (ingress_->has_flight_recorder())
       dump_writer_.emplace(DumpWriter::Options{config_.pcap_dir,
@@ -339,6 +359,26 @@ void Gateway::run(const std::atomic<bool>& stop, std::atomic<bool>* dump, LoopOb
   status_.publish(final_stats);
   stats_file_.write_now(final_stats);
   spdlog::info("stopping: {}", summary_line(final_stats));
+}
+
+// Another program's writer of the state topic in this partition -- another robot's gateway started
+// from a copy of this one's file -- mixes the two robots for every reader: said at once and loudly
+// (an error, the status line, /readyz, rsg_state_other_writers), and said again when it is gone.
+void Gateway::check_other_writers() {
+  const auto count = static_cast<std::uint32_t>(
+      dds::count_other_writers(state_topic_, partitions_of(config_), own_participant_, writers_.writers()));
+  if (count == other_state_writers_) return;
+  if (count > 0)
+    spdlog::error(
+        "{} other writer{} of '{}' in {} on domain {}: another robot's gateway (or a replay) writes this "
+        "topic here, and every reader gets both robots' samples interleaved; give each robot its own "
+        "partition (rsg-gateway@NAME takes NAME unless its file sets one)",
+        count, count == 1 ? "" : "s", state_topic_, dds::describe_partitions(partitions_of(config_)),
+        config_.domain);
+  else
+    spdlog::info("no other writer of '{}' in {} any more", state_topic_,
+                 dds::describe_partitions(partitions_of(config_)));
+  other_state_writers_ = count;
 }
 
 void Gateway::on_link_change() {
@@ -443,6 +483,7 @@ status::GatewayStats Gateway::on_status_period(Clock::time_point now) {
   if (ingress_) {
     rate_hz_ = rate_.update(ingress_->valid_frames(), now);
     ingress_->log_rejections();
+    check_other_writers();
   }
   const status::GatewayStats stats = snapshot();
   if (ingress_) ingress_->end_status_period();
@@ -464,6 +505,7 @@ status::GatewayStats Gateway::snapshot() const {
     stats.egress_writers = egress_->matched_writers();
   }
   stats.rate_hz = stats.link_up ? rate_hz_ : 0.0;
+  stats.other_state_writers = other_state_writers_;
   return stats;
 }
 

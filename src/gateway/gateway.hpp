@@ -6,6 +6,7 @@
 #pragma once
 
 #include <atomic>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -22,6 +23,7 @@
 #include "gateway/no_link_warning.hpp"
 #include "gateway/stats_file.hpp"
 #include "gateway/status_publisher.hpp"
+#include "rsg/dds/writer_directory.hpp"
 
 namespace rsg::gateway {
 
@@ -33,9 +35,18 @@ struct GatewaySetup {
   std::optional<transport::Endpoint> metrics;  ///< where /metrics is served
 };
 
+/// What prepare() prepares for: a start, or `--check-config`, which accepts the directories the
+/// systemd unit creates at its start missing (they exist only while it runs).
+enum class PrepareFor { kStart, kCheck };
+
 /// Resolves and checks everything that can be checked without creating entities.
 /// @throws rsg::InputError with a message naming the flag, file or profile at fault.
-GatewaySetup prepare(const GatewayConfig& config);
+GatewaySetup prepare(const GatewayConfig& config, PrepareFor purpose = PrepareFor::kStart);
+
+/// The participant profile's QoS, with ${CREDENTIALS_DIRECTORY} expanded in its properties.
+/// @throws rsg::InputError when the profile is not loaded or a property needs a credential that
+/// systemd did not hand over.
+eprosima::fastdds::dds::DomainParticipantQos profile_participant_qos(const GatewayConfig& config);
 
 /// A configuration re-read for SIGHUP on the signal's thread, handed to the loop, which never
 /// reads files: the configuration, or why it could not be read.
@@ -80,6 +91,7 @@ class Gateway {
 
  private:
   void on_link_change();
+  void check_other_writers();
   void dump_flight_recorder(std::string_view reason);
   void take_reload(PendingReload& reload);
   status::GatewayStats on_status_period(Clock::time_point now);  // returns the stats it reported
@@ -87,7 +99,8 @@ class Gateway {
   MetricsSnapshot metrics_snapshot(const status::GatewayStats& stats, Clock::time_point now) const;
 
   GatewayConfig config_;
-  dds::Participant participant_;  // first: outlives every entity below
+  dds::WriterDirectory writers_;  // before the participant, whose discovery it hears
+  dds::Participant participant_;  // outlives every entity below
   StatusPublisher status_;
   std::optional<Ingress> ingress_;
   std::optional<Egress> egress_;
@@ -100,9 +113,12 @@ class Gateway {
   LogThrottle dump_throttled_log_{std::chrono::minutes(1)};
   LogThrottle dump_refused_log_{std::chrono::minutes(1)};
   ReloadCounts reloads_;
-  double link_last_change_s_ = 0;         // Unix time, for the metrics
-  std::string gateway_label_;             // the metrics' `gateway` label
-  std::optional<MetricsServer> metrics_;  // last: serves snapshots of everything above
+  std::string own_participant_;            // participant_'s GUID prefix, dds::participant_key
+  std::string state_topic_;                // ingress's DDS topic; "" without ingress
+  std::uint32_t other_state_writers_ = 0;  // of state_topic_ in the partition, by other programs
+  double link_last_change_s_ = 0;          // Unix time, for the metrics
+  std::string gateway_label_;              // the metrics' `gateway` label
+  std::optional<MetricsServer> metrics_;   // last: serves snapshots of everything above
 };
 
 /// Puts the calling thread (the one that will call `Gateway::run`) in the configured real-time

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -47,6 +48,7 @@ Whatever is refused is logged as one warning and the gateway runs without it.)";
 // What the command line says besides the configuration keys.
 struct Command {
   std::string config_file;
+  std::string instance;     ///< --instance: the unit's instance name, whose defaults go under the file
   bool check_only = false;  ///< --check-config: check everything, start nothing
 };
 
@@ -55,10 +57,17 @@ struct Command {
 void add_config_flags(CLI::App& app, GatewayConfig& config, Command& command) {
   app.add_option("--config", command.config_file,
                  "YAML file with the same keys as the long flags (flags win)");
+  app.add_option("--instance", command.instance,
+                 "The instance NAME of the systemd unit rsg-gateway@NAME: partition NAME, stats-file "
+                 "/run/rsg/NAME/stats.json and pcap-dir /var/lib/rsg/NAME (the unit's directories) unless "
+                 "the file or a flag sets them");
   app.add_flag("--check-config,--check", command.check_only,
-               "Check the configuration (flags, --config file, XML profiles, addresses, files to write) "
-               "the way a start does, print what it found and exit: 0 when the gateway would start with "
-               "it, 2 when not; opens no socket and enables no DDS participant");
+               "Check the configuration (flags, --config file, XML profiles and the files they name, "
+               "addresses and ports, files to write) the way a start does, print what it found and exit: "
+               "0 when the gateway would start with it, 2 when the configuration is wrong, 1 when this "
+               "host refuses what it needs (an address not on it, a port in use); binds the ports and "
+               "closes them at once, enables no DDS participant, and does not require the directories "
+               "the unit creates at start");
   for (const rsg::gateway::ConfigKey& key : rsg::gateway::config_keys()) {
     const std::string flag = "--" + std::string(key.name);
     const std::string help(key.help);
@@ -79,6 +88,10 @@ void add_config_flags(CLI::App& app, GatewayConfig& config, Command& command) {
 }
 
 std::string read_file(const std::string& path) {
+  std::error_code error;
+  // An ifstream opens a directory and reads nothing from it: it would be an empty configuration.
+  if (std::filesystem::is_directory(path, error))
+    throw rsg::InputError("--config: '" + path + "' is a directory: " + rsg::gateway::errno_text(EISDIR));
   std::ifstream in(path);
   if (!in) throw rsg::InputError("--config: cannot read " + path + ": " + rsg::gateway::errno_text(errno));
   std::ostringstream text;
@@ -86,18 +99,26 @@ std::string read_file(const std::string& path) {
   return text.str();
 }
 
-// The configuration: the file (--config) with the flags over it, or the flags alone.
-// @throws rsg::InputError when the file cannot be read or does not parse.
-GatewayConfig read_config(const std::string& config_file, const GatewayConfig& flags_only, int argc,
-                          char** argv) {
-  if (config_file.empty()) return flags_only;
-  const rsg::gateway::ConfigResult parsed = rsg::gateway::parse_gateway_config(read_file(config_file));
-  if (!parsed) {
-    const auto& error = parsed.error();
-    throw rsg::InputError(config_file + (error.line > 0 ? ":" + std::to_string(error.line) : std::string()) +
-                          ": " + error.message);
+// The configuration: the instance's defaults (--instance), the file (--config) over them, the
+// flags over both.
+// @throws rsg::InputError when the file cannot be read or does not parse, or the instance is no name.
+GatewayConfig read_config(const Command& command, const GatewayConfig& flags_only, int argc, char** argv) {
+  if (command.config_file.empty() && command.instance.empty()) return flags_only;
+  GatewayConfig config;
+  if (!command.instance.empty()) {
+    auto defaults = rsg::gateway::instance_defaults(command.instance);
+    if (const auto* why = std::get_if<std::string>(&defaults)) throw rsg::InputError(*why);
+    config = std::get<GatewayConfig>(std::move(defaults));
   }
-  GatewayConfig config = parsed.config();
+  if (const std::string& file = command.config_file; !file.empty()) {
+    const rsg::gateway::ConfigResult parsed = rsg::gateway::parse_gateway_config(read_file(file), config);
+    if (!parsed) {
+      const auto& error = parsed.error();
+      throw rsg::InputError(file + (error.line > 0 ? ":" + std::to_string(error.line) : std::string()) +
+                            ": " + error.message);
+    }
+    config = parsed.config();
+  }
   CLI::App app("rsg_gateway", "rsg_gateway");
   Command ignored;
   add_config_flags(app, config, ignored);
@@ -122,16 +143,21 @@ int main(int argc, char** argv) {
   add_config_flags(app, flags_only, command);
 
   return rsg::app::run_main(app, argc, argv, [&] {
-    const GatewayConfig config = read_config(command.config_file, flags_only, argc, argv);
+    const GatewayConfig config = read_config(command, flags_only, argc, argv);
     // Every value is checked before any is used: a log level spdlog does not know would otherwise
     // turn the log off, this message with it.
     if (auto problem = rsg::gateway::check_config(config)) throw rsg::InputError(*problem);
     spdlog::set_level(spdlog::level::from_str(rsg::gateway::log_level_name(config)));
     if (config.log_format == "json") rsg::gateway::use_json_log_lines();  // every line from here on
-    const rsg::gateway::GatewaySetup setup = rsg::gateway::prepare(config);
+    const rsg::gateway::GatewaySetup setup = rsg::gateway::prepare(
+        config, command.check_only ? rsg::gateway::PrepareFor::kCheck : rsg::gateway::PrepareFor::kStart);
+    // At a start too: Fast DDS refuses a participant whose security file is missing without naming it.
+    rsg::gateway::check_profile_files(config);
     if (command.check_only) {
       rsg::gateway::check_entity_profiles_offline(config);
-      std::fputs(rsg::gateway::describe_setup(setup, command.config_file).c_str(), stdout);
+      // Last: what a start does first with the configuration.
+      const std::vector<std::string> notes = rsg::gateway::check_bindings(setup, command.config_file);
+      std::fputs(rsg::gateway::describe_setup(setup, command.config_file, notes).c_str(), stdout);
       return kExitOk;
     }
     // SIGUSR1 asks for a flight-recorder dump: the loop takes it when it sees `dump`. SIGHUP's
@@ -142,7 +168,7 @@ int main(int argc, char** argv) {
     rsg::gateway::PendingReload reload;
     const auto reread = [&] {
       try {
-        reload.offer(read_config(command.config_file, flags_only, argc, argv));
+        reload.offer(read_config(command, flags_only, argc, argv));
       } catch (const std::exception& error) {  // a bad file must not end a running gateway
         reload.offer(std::string(error.what()));
       }

@@ -94,6 +94,10 @@ constexpr Family kLinkChange{"rsg_link_last_change_timestamp_seconds", Type::kGa
 constexpr Family kRate{"rsg_frame_rate_hertz", Type::kGauge,
                        "Valid frames per second over the last status period (0 while the link is down)"};
 constexpr Family kStateReaders{"rsg_state_readers", Type::kGauge, "Readers matched by the RobotState writer"};
+constexpr Family kOtherWriters{"rsg_state_other_writers", Type::kGauge,
+                               "Writers of the state topic in the gateway's partition by other programs "
+                               "(another robot's gateway with the same partition, a replay): 0 unless "
+                               "robots are mixed"};
 constexpr Family kStandardReaders{"rsg_standard_topics_readers", Type::kGauge,
                                   "Readers matched by the ROS 2 standard topics' writers, summed"};
 constexpr Family kEgressWriters{"rsg_egress_writers", Type::kGauge, "Writers matched by the egress reader"};
@@ -138,6 +142,7 @@ constexpr std::array kFamilies = {&kBuildInfo,
                                   &kLinkChange,
                                   &kRate,
                                   &kStateReaders,
+                                  &kOtherWriters,
                                   &kStandardReaders,
                                   &kEgressWriters,
                                   &kDelay,
@@ -338,6 +343,7 @@ std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<
   out.one(kLinkChange, snapshot.link_last_change_s);
   out.one(kRate, stats.rate_hz);
   out.one(kStateReaders, stats.state_readers);
+  out.one(kOtherWriters, stats.other_state_writers);
   out.one(kStandardReaders, stats.standard_readers);
   out.one(kEgressWriters, stats.egress_writers);
   if (snapshot.has_ingress) {
@@ -366,7 +372,8 @@ bool is_live(const MetricsSnapshot& snapshot, Clock::time_point now, Clock::dura
 }
 
 bool is_ready(const MetricsSnapshot& snapshot, Clock::time_point now, Clock::duration max_age) {
-  return is_live(snapshot, now, max_age) && (!snapshot.has_ingress || snapshot.stats.link_up);
+  return is_live(snapshot, now, max_age) &&
+         (!snapshot.has_ingress || (snapshot.stats.link_up && snapshot.stats.other_state_writers == 0));
 }
 
 }  // namespace rsg::gateway

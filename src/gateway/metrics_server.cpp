@@ -171,10 +171,15 @@ class Session : public std::enable_shared_from_this<Session>, public app::Connec
       const auto now = Clock::now();
       const bool live = is_live(*snapshot, now, shared_.options.max_snapshot_age);
       const bool ok = target == "/livez" ? live : is_ready(*snapshot, now, shared_.options.max_snapshot_age);
+      const auto& stats = snapshot->stats;
       return respond(version, keep_alive, ok ? http::status::ok : http::status::service_unavailable,
-                     ok     ? "ok\n"
-                     : live ? "link down\n"
-                            : "stale: the gateway's loop has not reported for too long\n");
+                     ok      ? "ok\n"
+                     : !live ? "stale: the gateway's loop has not reported for too long\n"
+                     : stats.other_state_writers > 0
+                         ? fmt::format("another writer of the state topic in this partition ({}): robots "
+                                       "mixed\n",
+                                       stats.other_state_writers)
+                         : "link down\n");
     }
     respond(version, keep_alive, http::status::not_found,
             "not found: /metrics, /livez, /readyz and /healthz only\n");
@@ -241,6 +246,13 @@ MetricsServer::MetricsServer(const Options& options, MetricsSnapshot first)
     ::pthread_setname_np(::pthread_self(), "rsg-metrics");
     impl->io.run();
   });
+}
+
+void MetricsServer::check_can_listen(const transport::Endpoint& listen) {
+  net::io_context io;
+  tcp::acceptor acceptor(io);
+  if (const auto ec = rsg::app::listen_on(acceptor, to_asio(listen)))
+    throw EnvironmentError("--metrics: cannot listen on " + listen.to_string() + ": " + ec.message());
 }
 
 MetricsServer::~MetricsServer() {

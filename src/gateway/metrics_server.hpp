@@ -45,6 +45,9 @@ class MetricsServer {
 
   /// Binds and starts serving. Throws rsg::EnvironmentError when the address cannot be bound.
   MetricsServer(const Options& options, MetricsSnapshot first);
+  /// Listens on `listen` as the constructor does, and closes it again (--check-config).
+  /// @throws rsg::EnvironmentError with the constructor's message when it cannot.
+  static void check_can_listen(const transport::Endpoint& listen);
   ~MetricsServer();
   MetricsServer(const MetricsServer&) = delete;
   MetricsServer& operator=(const MetricsServer&) = delete;

@@ -67,6 +67,11 @@ std::string service_status_line(const status::GatewayStats& stats, bool has_ingr
     line = fmt::format("egress only, {} sent", stats.egress.frames_sent);
   }
   line += fmt::format(", {} reader{}", readers, readers == 1 ? "" : "s");
+  // First, where `systemctl status` cuts a long line last: readers get two robots' samples mixed.
+  if (stats.other_state_writers > 0)
+    line = fmt::format("ROBOTS MIXED: {} other writer{} of the state topic in this partition; ",
+                       stats.other_state_writers, stats.other_state_writers == 1 ? "" : "s") +
+           line;
   if (stats.egress_writers > 0)
     line += fmt::format(", {} egress writer{}", stats.egress_writers, stats.egress_writers == 1 ? "" : "s");
   return line;

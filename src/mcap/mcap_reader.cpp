@@ -194,6 +194,13 @@ MappedFile::MappedFile(const std::filesystem::path& path) {
     ::close(fd);
     throw InputError("cannot stat " + path.string() + ": " + std::strerror(error));
   }
+  // mmap of a directory fails with ENODEV ("No such device"), which names nothing the user did.
+  if (!S_ISREG(status.st_mode)) {
+    ::close(fd);
+    throw InputError(path.string() +
+                     (S_ISDIR(status.st_mode) ? " is a directory" : " is not a regular file") +
+                     ", not an MCAP file");
+  }
   size_ = static_cast<std::size_t>(status.st_size);
   if (size_ > 0) {
     void* data = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);

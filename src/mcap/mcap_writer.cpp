@@ -23,9 +23,10 @@ std::uint32_t crc32(std::uint32_t previous, std::span<const std::uint8_t> bytes)
 /// The output file descriptor; the writer only ever appends, or cuts back to a record boundary.
 class Writer::File {
  public:
-  explicit File(const std::filesystem::path& path) : path_(path) {
-    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd_ < 0) throw error("cannot create");
+  File(const std::filesystem::path& path, bool exclusive) : path_(path) {
+    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | (exclusive ? O_EXCL | O_NOFOLLOW : O_TRUNC),
+                 0644);
+    if (fd_ < 0) throw error(exclusive && errno == EEXIST ? "will not overwrite" : "cannot create");
   }
   ~File() {
     if (fd_ >= 0) ::close(fd_);
@@ -80,7 +81,7 @@ struct Writer::Compressor {
 
 Writer::Writer(const std::filesystem::path& path, WriterOptions options)
     : options_(std::move(options)),
-      file_(std::make_unique<File>(path)),
+      file_(std::make_unique<File>(path, options_.exclusive)),
       compressor_(std::make_unique<Compressor>()) {
   if (!compressor_->context) throw WriteError("zstd: cannot create a compression context");
   chunk_.reserve(options_.chunk_bytes + 4096);

@@ -48,6 +48,9 @@ struct WriterOptions {
   /// fdatasync(2) after every finished chunk and at close: what was written survives a power loss,
   /// not only a crash of the process, at the cost of one disk flush per chunk (see WriterTotals).
   bool sync = false;
+  /// Create the file only if there is none at the path (O_EXCL, and O_NOFOLLOW: a symlink planted
+  /// there is not followed): a recorder never overwrites a file, its own earlier ones included.
+  bool exclusive = false;
 };
 
 /// What the file holds so far (finished chunks only for the byte counts).

@@ -52,6 +52,11 @@ struct GatewayStats {
   /// Readers matched by the ROS 2 standard topics' writers (joint_states, tf, external_wrench),
   /// summed: the writers' side of discovery, which a test waits for before the robot sends.
   std::uint32_t standard_readers = 0;
+  /// Writers of the gateway's state topic in its partition that belong to other programs: another
+  /// robot's gateway with the same partition (its readers get both robots' samples interleaved), a
+  /// replay. 0 unless robots are mixed. In the metrics, /readyz and the status line; not in
+  /// GatewayStatus, nor in the stats file, which has GatewayStatus's members.
+  std::uint32_t other_state_writers = 0;
   SequenceTracker::Counts sequence;
   EgressCounters egress;
   /// Snapshots for the ROS 2 standard topics dropped because their publishing thread was a whole

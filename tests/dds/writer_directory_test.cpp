@@ -98,5 +98,47 @@ TEST(WriterDirectory, AWriterThatShouldMatchButDoesNotPointsAtQosOrSecurity) {
       "and partition, yet not matched: their QoS or security settings differ");
 }
 
+TEST(WriterDirectory, TwoParticipantsWritingOnePartitionAreSaidToBeMixed) {
+  const DiscoveredWriter robot1{"robot_state", "rsg::RobotState", {"robot1"}, "01.0f.aa"};
+  DiscoveredWriter robot2 = robot1;
+  robot2.participant = "01.0f.bb";
+  const auto lines = dds::explain_mixed_writers(kWanted, {robot1, robot2});
+  ASSERT_EQ(lines.size(), 1u) << joined(lines);
+  EXPECT_NE(lines[0].find("2 programs write 'robot_state' in partition 'robot1'"), std::string::npos)
+      << lines[0];
+  EXPECT_NE(lines[0].find("own partition"), std::string::npos) << lines[0];
+}
+
+TEST(WriterDirectory, OneParticipantPerPartitionIsNotMixed) {
+  // Two writers of one participant (the gateway's state and a second writer of it), and a reader
+  // of every partition that sees one robot in each.
+  const DiscoveredWriter a{"robot_state", "rsg::RobotState", {"robot1"}, "01.0f.aa"};
+  EXPECT_TRUE(dds::explain_mixed_writers(kWanted, {a, a}).empty());
+  const WantedWriter every{0, "robot_state", "rsg::RobotState", {"*"}};
+  DiscoveredWriter b = a;
+  b.partitions = {"robot2"};
+  b.participant = "01.0f.bb";
+  EXPECT_TRUE(dds::explain_mixed_writers(every, {a, b}).empty());
+  // Another topic in the same partition is not the reader's.
+  DiscoveredWriter status = b;
+  status.topic = "rsg_gateway_status";
+  status.partitions = {"robot1"};
+  EXPECT_TRUE(dds::explain_mixed_writers(kWanted, {a, status}).empty());
+}
+
+TEST(WriterDirectory, AGatewayCountsTheOtherParticipantsWritersOfItsTopicInItsPartition) {
+  const DiscoveredWriter own{"robot_state", "rsg::RobotState", {"robot1"}, "01.0f.aa"};
+  DiscoveredWriter other = own;
+  other.participant = "01.0f.bb";
+  DiscoveredWriter elsewhere = other;
+  elsewhere.partitions = {"robot2"};
+  DiscoveredWriter pattern = other;
+  pattern.partitions = {"robot*"};
+  EXPECT_EQ(dds::count_other_writers("robot_state", {"robot1"}, "01.0f.aa", {own}), 0u);
+  EXPECT_EQ(dds::count_other_writers("robot_state", {"robot1"}, "01.0f.aa", {own, other, elsewhere}), 1u);
+  EXPECT_EQ(dds::count_other_writers("robot_state", {"robot1"}, "01.0f.aa", {own, pattern}), 1u);
+  EXPECT_EQ(dds::count_other_writers("robot_state_50hz", {"robot1"}, "01.0f.aa", {own, other}), 0u);
+}
+
 }  // namespace
 }  // namespace rsg

@@ -29,6 +29,9 @@ STALE_CLAIMS = [
      "views are filtered by the reader, never by the gateway's writer (docs/operating.md)"),
     (r"writer[- ]side (?:content )?filter(?:ing|ed)? (?:of|for) (?:the |a )?views?",
      "views are filtered by the reader, never by the gateway's writer (docs/operating.md)"),
+    # "writer-side filtering with the gateway's profile then holds on 3.1.2 as on 2.9" (issue 50).
+    (r"writer[- ]side (?:content )?filter(?:ing|ed)?\b[^.]{0,80}?\bholds\b",
+     "the gateway's writers filter nothing: views are filtered by the reader (docs/operating.md)"),
 ]
 # Where a guide explains the writer-side filtering rsg turned off, or how to turn it on for one's own
 # writer: a match within such a sentence is not a claim about rsg's views.

@@ -104,6 +104,42 @@ TEST(GatewayConfig, MissingColonNamesTheLineItIsMissingFrom) {
       6);
 }
 
+TEST(GatewayConfig, AColonlessLastLineGetsTheSameHintNotTheListOfKeys) {
+  // yaml-cpp reads "topic robot" on the last line as a key without a value.
+  for (const char* text : {"listen: 127.0.0.1:5000\ndomain: 3\ntopic robot\n", "listen 127.0.0.1:5000\n"}) {
+    const ConfigError error = parse_error(text);
+    EXPECT_NE(error.message.find("not a 'key: value' line (a missing ':' after '"), std::string::npos)
+        << error.message;
+    EXPECT_EQ(error.message.find("known:"), std::string::npos) << error.message;
+  }
+  // A word that is no key is still an unknown key.
+  EXPECT_NE(parse_error("listen: a:1\nfoo bar\n").message.find("unknown key 'foo bar'"), std::string::npos);
+}
+
+TEST(GatewayConfig, AnInstanceNamesItsPartitionAndTheUnitsDirectories) {
+  const auto defaults = instance_defaults("robot2");
+  ASSERT_TRUE(std::holds_alternative<GatewayConfig>(defaults));
+  const GatewayConfig& config = std::get<GatewayConfig>(defaults);
+  EXPECT_EQ(config.partition, "robot2");
+  EXPECT_EQ(config.stats_file, "/run/rsg/robot2/stats.json");
+  EXPECT_EQ(config.pcap_dir, "/var/lib/rsg/robot2");
+  // Under the file: what the file sets wins.
+  const ConfigResult parsed = parse_gateway_config("partition: robot1\n", config);
+  ASSERT_TRUE(parsed);
+  EXPECT_EQ(parsed.config().partition, "robot1");
+  EXPECT_EQ(parsed.config().stats_file, "/run/rsg/robot2/stats.json");
+  for (const char* bad : {"", ".", "..", "a/b"})
+    EXPECT_TRUE(std::holds_alternative<std::string>(instance_defaults(bad)));
+}
+
+TEST(GatewayConfig, TheUnitsDirectoriesAreOneNameBelowTheirRoots) {
+  EXPECT_EQ(unit_directory_kind("/run/rsg/robot1").value_or(""), "RuntimeDirectory=");
+  EXPECT_EQ(unit_directory_kind("/run/rsg/robot1/").value_or(""), "RuntimeDirectory=");
+  EXPECT_EQ(unit_directory_kind("/var/lib/rsg/robot1").value_or(""), "StateDirectory=");
+  for (const char* other : {"/run/rsg", "/run/rsg/", "/run/rsg/a/b", "/run/rsg/..", "/run/rsgx/a", "/tmp/a"})
+    EXPECT_FALSE(unit_directory_kind(other).has_value()) << other;
+}
+
 TEST(GatewayConfig, LogLevelInAnyCase) {
   const GatewayConfig config = parse_ok("log-level: WARN");
   EXPECT_EQ(log_level_name(config), "warn");

@@ -210,5 +210,18 @@ TEST(Metrics, LiveWhileTheSnapshotIsFreshReadyWhileTheLinkIsUpToo) {
   EXPECT_TRUE(is_ready(snapshot, now, max_age)) << "egress only: no link to watch";
 }
 
+TEST(Metrics, NotReadyWhileAnotherRobotWritesInThePartition) {
+  MetricsSnapshot snapshot = example();
+  const auto now = Clock::now();
+  snapshot.taken = now;
+  const auto max_age = std::chrono::seconds(3);
+  ASSERT_TRUE(is_ready(snapshot, now, max_age));
+  snapshot.stats.other_state_writers = 1;
+  EXPECT_FALSE(is_ready(snapshot, now, max_age)) << "its readers get two robots' samples";
+  EXPECT_TRUE(is_live(snapshot, now, max_age)) << "restarting it would not help";
+  const std::string text = format_metrics(snapshot, std::nullopt);
+  EXPECT_NE(text.find("rsg_state_other_writers{gateway=\""), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace rsg::gateway

@@ -90,6 +90,15 @@ TEST(ServiceNotifier, StartedSendsReadyWithAStatusLine) {
   EXPECT_EQ(socket.next(), "STOPPING=1");
 }
 
+TEST(ServiceNotifier, TheStatusLineSaysFirstThatRobotsAreMixed) {
+  status::GatewayStats stats = streaming();
+  stats.other_state_writers = 1;
+  EXPECT_EQ(
+      service_status_line(stats, true, {}),
+      "ROBOTS MIXED: 1 other writer of the state topic in this partition; link up from 127.0.0.1:40000 at "
+      "1000.0 Hz, 2 readers");
+}
+
 TEST(ServiceNotifier, TheStatusLineNamesWhatKeepsTheLinkDown) {
   NotifySocket socket;
   ServiceNotifier notifier;

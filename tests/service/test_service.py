@@ -27,7 +27,10 @@ the ones before left:
   watchdog      the gateway frozen with SIGSTOP: systemd's watchdog kills it ("Watchdog timeout" in
                 the journal) within WatchdogSec (5 s) + WATCHDOG_MARGIN_S, and restarts it
   upgrade       apt-get install of the current .deb over the older one: the running instance is
-                restarted by postinst on the new version and frames arrive exact
+                restarted by postinst on the new version and frames arrive exact; a second
+                instance whose file was broken meanwhile does not come back: postinst names it
+                (and the one it restarted), the install fails, and `dpkg --configure -a`
+                finishes once the file is fixed
   ros2_type_hash  a second instance with --ros2 and the standard topics: a Kilted and a Jazzy
                 rclpy node on the host (make deps' ROS 2 environments) see rosidl's RIHS01 hash on all
                 five writers
@@ -68,6 +71,8 @@ UNIT = "rsg-gateway@robot1.service"
 BROKEN = "rsg-gateway@broken.service"
 ROS2_INSTANCE = "ros2"  # a second instance, with --ros2 and the standard topics
 ROS2_UNIT = f"rsg-gateway@{ROS2_INSTANCE}.service"
+LOST_INSTANCE = "robot3"  # an instance that does not come back after the upgrade
+LOST_UNIT = f"rsg-gateway@{LOST_INSTANCE}.service"
 STATS = "/run/rsg/robot1/stats.json"
 WATCHDOG_S = 5  # WatchdogSec= of deploy/systemd/rsg-gateway@.service
 # What the watchdog kill may take beyond WatchdogSec: the SIGABRT's core dump and systemd's tick.
@@ -270,6 +275,11 @@ class Run:
         check(bound, f"{UNIT} was active before its UDP port {self.port} was bound")
         check(stats is not None, f"{UNIT} was active before its stats file {STATS} was written")
         check(self.box.show(UNIT, "Type") == "notify", f"{UNIT} is not Type=notify")
+        # The memory bound and the restart policy (never given up) as systemd read them.
+        memory_max = self.box.show(UNIT, "MemoryMax")
+        check(memory_max.isdigit(), f"{UNIT}'s MemoryMax is {memory_max!r}, not a bound")
+        check(self.box.show(UNIT, "StartLimitIntervalUSec") in ("0", "0s"),
+              f"{UNIT} has a start limit: {self.box.show(UNIT, 'StartLimitIntervalUSec')}")
         status = wait_for(lambda: self.box.show(UNIT, "StatusText"), "the gateway's STATUS= line", timeout_s=10)
         # The stats file: readable by the group rsg (the unit's Group=), by no other user. setpriv
         # runs as IDs no user has, so that the users and groups stay as they were for `purge`.
@@ -423,8 +433,22 @@ class Run:
         pid = self.box.main_pid()
         matches = len(self.echo_matches())
         new = Path(self.args.deb)
-        self.box.sh(f"DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "
-                    f"-o Dpkg::Options::=--force-confold /debs/{new.name}")
+        # A second instance that will not come back: running on a good file, which is then broken
+        # (an unknown key) before the upgrade restarts it.
+        self.box.sh(f"printf 'listen: 127.0.0.1:{free_udp_port()}\\ndomain: {self.domain}\\n' > /etc/rsg/{LOST_INSTANCE}.yaml"
+                    f" && systemctl start {LOST_UNIT}")
+        self.box.sh(f"printf 'no-such-key: 1\\n' >> /etc/rsg/{LOST_INSTANCE}.yaml")
+        install = subprocess.run(
+            [*self.box.engine, "exec", self.box.name, "sh", "-c",
+             f"DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "
+             f"-o Dpkg::Options::=--force-confold /debs/{new.name}"], capture_output=True, text=True, timeout=600)
+        said = install.stdout + install.stderr
+        check(install.returncode != 0, f"the upgrade succeeded though {LOST_UNIT} did not come back:\n{said[-2000:]}")
+        check(f"{LOST_UNIT} did not come back after the upgrade" in said and f"{UNIT} restarted on the new version" in said,
+              f"postinst did not name the instance that failed and the one restarted:\n{said[-2000:]}")
+        # Fixed, dpkg finishes the configuration.
+        self.box.sh(f"systemctl stop {LOST_UNIT}; systemctl reset-failed {LOST_UNIT}; rm /etc/rsg/{LOST_INSTANCE}.yaml; "
+                    "dpkg --configure -a")
         version = self.box.sh("dpkg-query -W -f '${Version}' rsg")
         check(version == self.deb_version(new), f"after the upgrade rsg {version} is installed, not {self.deb_version(new)}")
         check(self.box.sh("cat /etc/rsg/robot1.yaml") == self.config(), "the upgrade changed the edited robot1.yaml")
@@ -433,7 +457,8 @@ class Run:
         self.send_and_check("upgrade")
         check(self.echo.wait(timeout=60) == 0, f"rsg_echo exited non-zero: {self.echo_err.read_text()[-500:]}")
         print(f"[service] upgrade: {self.deb_version(Path(self.args.old_deb))} -> {version}, pid {pid} restarted as "
-              f"{new_pid}, the edited conffile kept", flush=True)
+              f"{new_pid}, the edited conffile kept; postinst named {LOST_UNIT}, which did not come back, and "
+              f"exited non-zero; dpkg --configure -a finished once it was fixed", flush=True)
 
     def ros2_type_hash(self):
         """The packaged gateway as a second instance with --ros2 and the standard topics: a real rclpy

@@ -60,6 +60,7 @@ BAD_VALUES = {
     "rsg_gateway": {
         "--config": ["--config", MISSING],
         "--check-config": ["--check-config=maybe"],
+        "--instance": ["--instance", "../etc"],
         "--listen": ["--listen", BAD_HOST_PORT],
         "--allow-from": ["--allow-from", "10.0.0.0/40"],
         "--topic": ["--topic", ""],
@@ -114,6 +115,7 @@ BAD_VALUES = {
     },
     "rsg_echo": {
         **DDS_READER,
+        "--log-level": ["--log-level", "loud"],
         "--ros2": ["--ros2=maybe"],
         "--ros2-namespace": ["--ros2", "--ros2-namespace", "no space"],
         "--groups": ["--groups", "9"],
@@ -136,6 +138,8 @@ BAD_VALUES = {
         "--pre": ["--trigger", "signal", "--pre", "-1"],
         "--post": ["--trigger", "signal", "--post", "-1"],
         "--trigger-buffer": ["--trigger", "signal", "--trigger-buffer", "0"],
+        "--event-max-duration": ["--trigger", "signal", "--event-max-duration", "0"],
+        "--event-max-size": ["--trigger", "signal", "--event-max-size", "-1"],
         "--chunk-size": ["--chunk-size", "10"],
         "--fsync": ["--fsync=maybe"],
     },
@@ -181,6 +185,7 @@ BAD_VALUES = {
     },
     "rsg_view": {
         **DDS_READER,
+        "--log-level": ["--log-level", "loud"],
         "--listen": ["--listen", BAD_HOST_PORT],
         "--status-topic": ["--status-topic", CONTROL],
         "--max-clients": ["--max-clients", "0"],

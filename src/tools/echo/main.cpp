@@ -24,6 +24,7 @@
 #include "app/dds_options.hpp"
 #include "app/discovery_cli.hpp"
 #include "app/matched_writers.hpp"
+#include "app/number_checks.hpp"
 #include "app/stop_on_signal.hpp"
 #include "app/tool_main.hpp"
 #include "rsg/dds/fastdds.hpp"
@@ -133,6 +134,7 @@ class SampleSink {
 };
 
 void add_options(CLI::App& app, Options& options) {
+  rsg::app::add_log_level_option(app);
   app.add_option("--domain", options.domain, "DDS domain id")
       ->check(CLI::Range(0, 232))
       ->capture_default_str();
@@ -160,7 +162,7 @@ void add_options(CLI::App& app, Options& options) {
   app.add_option("--timeout", options.timeout_seconds,
                  "Exit 1 when no sample arrives for this many seconds, from start-up or the last "
                  "sample (default: wait forever)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(rsg::app::non_negative_number());
   rsg::app::add_profile_options(app, options.profiles, options.participant_profile,
                                 "XML participant profile, e.g. rsg_secure_reader under DDS Security");
   rsg::app::add_discovery_options(app, options.discovery);

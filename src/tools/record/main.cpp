@@ -16,17 +16,21 @@
 #include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <ctime>
 #include <deque>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <limits>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "app/discovery_cli.hpp"
 #include "app/file_options.hpp"
 #include "app/matched_writers.hpp"
 #include "app/monitor_options.hpp"
 #include "app/monitor_readers.hpp"
+#include "app/number_checks.hpp"
 #include "app/recording.hpp"
 #include "app/recording_order.hpp"
 #include "app/stop_on_signal.hpp"
@@ -73,6 +77,10 @@ struct Options : rsg::app::MonitorOptions {
   double pre_s = 10;
   double post_s = 10;
   double trigger_buffer_mb = 64;  // what the --pre window may hold in memory
+  // An event's own bounds: an event that triggers keep extending is closed (and kept) at either,
+  // and the next trigger starts a new one.
+  double event_max_s = 60;
+  double event_max_mb = 100;
 
   bool triggered() const { return !triggers.empty(); }
   bool trigger_on(std::string_view what) const {
@@ -124,7 +132,11 @@ class Recording {
         pre_ns_(static_cast<std::uint64_t>(options.pre_s * 1e9)),
         post_ns_(static_cast<std::uint64_t>(options.post_s * 1e9)),
         buffer_bytes_(static_cast<std::uint64_t>(options.trigger_buffer_mb * 1e6)),
+        event_max_ns_(static_cast<std::uint64_t>(options.event_max_s * 1e9)),
+        event_max_bytes_(event_bytes_bound(options)),
+        run_stamp_(run_stamp()),
         order_(kHold) {
+    if (numbered_) adopt_earlier_files();
     if (!options.triggered()) {
       open();
       return;
@@ -166,11 +178,15 @@ class Recording {
   /// being recorded extends it.
   void trigger(std::uint64_t at_ns, std::string_view why) {
     ++triggers;
-    event_end_ = std::max(event_end_, at_ns + post_ns_);
     if (writer_) {
+      // Never past the event's own bound: triggers that keep coming (an attacker's invalid frames)
+      // would otherwise keep one file open and growing.
+      event_end_ = std::min(std::max(event_end_, at_ns + post_ns_), event_start_ + event_max_ns_);
       spdlog::info("{}: event {} extended to {:g} s after it", why, events - 1, options_.post_s);
       return;
     }
+    event_start_ = at_ns;
+    event_end_ = std::min(at_ns + post_ns_, at_ns + event_max_ns_);
     ++events;
     spdlog::info("{}: event {}, writing {} (up to {:g} s before, {:g} s after)", why, events - 1,
                  next_path().string(), options_.pre_s, options_.post_s);
@@ -191,7 +207,7 @@ class Recording {
     // An event's last samples are out of PublicationOrder `kHold` after they arrived.
     if (options_.triggered() && writer_ &&
         now >= event_end_ + static_cast<std::uint64_t>(std::chrono::nanoseconds(kHold).count()))
-      finish_event();
+      finish_event(end_bound());
     if (options_.max_age_s > 0) apply_retention();
   }
 
@@ -211,6 +227,14 @@ class Recording {
 
   rsg::app::PublicationOrder::Counts state_counts() const { return order_.counts(channels_.robot_state); }
 
+  /// What this run wrote, for a message saying it holds no state: the file, or that none was written
+  /// (--trigger without an event), or how many (--split-size).
+  std::string written() const {
+    if (files == 0) return "no file was written";
+    if (files == 1) return next_path_of(0).string() + " holds no state";
+    return fmt::format("its {} files ({}, ...) hold no state", files, next_path_of(0).string());
+  }
+
   std::uint64_t states = 0, statuses = 0;  // received
   std::uint64_t states_written = 0;
   std::uint64_t messages = 0, chunks = 0, uncompressed = 0, compressed = 0, file_bytes = 0;  // written
@@ -229,12 +253,93 @@ class Recording {
   };
 
   fs::path next_path() const { return next_path_of(files); }
+  // FILE_<run's start, UTC>_<index>.mcap: a restarted recorder's files never take an earlier run's
+  // names, and the names sort by time (runs by their start, a run's files by their zero-padded index).
   fs::path next_path_of(std::size_t index) const {
     if (!numbered_) return options_.out;
     fs::path path = options_.out;
-    path.replace_filename(options_.out.stem().string() + "_" + std::to_string(index) +
-                          options_.out.extension().string());
+    path.replace_filename(fmt::format("{}_{}_{:06}{}", options_.out.stem().string(), run_stamp_, index,
+                                      options_.out.extension().string()));
     return path;
+  }
+
+  // "20261202T150102.123Z": the run's start, to the millisecond (two starts in one millisecond
+  // would meet O_EXCL: "will not overwrite").
+  static std::string run_stamp() {
+    const auto now = std::chrono::system_clock::now();
+    const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
+    std::tm utc{};
+    ::gmtime_r(&seconds, &utc);
+    const auto ms =
+        std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+    return fmt::format("{:04}{:02}{:02}T{:02}{:02}{:02}.{:03}Z", utc.tm_year + 1900, utc.tm_mon + 1,
+                       utc.tm_mday, utc.tm_hour, utc.tm_min, utc.tm_sec, ms);
+  }
+
+  // Whether `name` is a file of this set: FILE_<stamp>_<index>.mcap, or FILE_<index>.mcap as rsg
+  // before 0.2 named them. Anything else in the directory is not the recorder's to remove.
+  bool of_this_set(const std::string& name) const {
+    const std::string stem = options_.out.stem().string() + "_";
+    const std::string extension = options_.out.extension().string();
+    if (!name.starts_with(stem) || !name.ends_with(extension) ||
+        name.size() <= stem.size() + extension.size())
+      return false;
+    const std::string middle = name.substr(stem.size(), name.size() - stem.size() - extension.size());
+    const auto digits = [](std::string_view text) {
+      return !text.empty() &&
+             std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    if (digits(middle)) return true;  // the older names
+    // 20261202T150102.123Z_000000
+    return middle.size() == 27 && digits(middle.substr(0, 8)) && middle[8] == 'T' &&
+           digits(middle.substr(9, 6)) && middle[15] == '.' && digits(middle.substr(16, 3)) &&
+           middle[19] == 'Z' && middle[20] == '_' && digits(middle.substr(21));
+  }
+
+  // Retention counts every file of the set, an earlier run's too (a recorder restarted by its
+  // supervisor would otherwise leave its predecessors' files for ever): they are taken as finished,
+  // oldest first (by name: the older names first, by index; then by run and index), before this run
+  // writes any.
+  void adopt_earlier_files() {
+    const fs::path dir = options_.out.parent_path().empty() ? fs::path(".") : options_.out.parent_path();
+    std::vector<std::pair<std::pair<int, std::string>, fs::path>> found;
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator(dir, error)) {
+      const std::string name = entry.path().filename().string();
+      std::error_code type_error;
+      if (!entry.is_regular_file(type_error) || entry.is_symlink(type_error) || !of_this_set(name)) continue;
+      const std::string middle = name.substr(options_.out.stem().string().size() + 1);
+      const bool older_name = middle.find('T') == std::string::npos;
+      // The older names by their number (run_2 before run_10), zero-padded to sort as text.
+      found.push_back(
+          {{older_name ? 0 : 1, older_name ? fmt::format("{:0>20}", middle) : name}, entry.path()});
+    }
+    if (error) throw rsg::mcap::WriteError("cannot list " + dir.string() + ": " + error.message());
+    std::sort(found.begin(), found.end());
+    const auto steady_now = std::chrono::steady_clock::now();
+    const auto file_now = fs::file_time_type::clock::now();
+    for (const auto& [order, path] : found) {
+      std::error_code stat_error;
+      const std::uintmax_t bytes = fs::file_size(path, stat_error);
+      const auto written = fs::last_write_time(path, stat_error);
+      if (stat_error) continue;  // gone meanwhile
+      finished_.push_back(
+          {path, static_cast<std::uint64_t>(bytes),
+           steady_now - std::chrono::duration_cast<std::chrono::steady_clock::duration>(file_now - written)});
+    }
+    if (!found.empty())
+      spdlog::info(
+          "{} earlier {} of {} counted by retention", found.size(), found.size() == 1 ? "file" : "files",
+          (dir / (options_.out.stem().string() + "_*" + options_.out.extension().string())).string());
+    apply_retention();
+  }
+
+  // The bytes an event file may reach: --event-max-size, and at most half of --max-size, so that
+  // retention keeps a closed event beside the next one.
+  static std::uint64_t event_bytes_bound(const Options& options) {
+    double mb = options.event_max_mb;
+    if (options.max_mb > 0) mb = std::min(mb, options.max_mb / 2);
+    return static_cast<std::uint64_t>(mb * 1e6);
   }
 
   void open() {
@@ -242,7 +347,8 @@ class Recording {
     writer_.emplace(path, rsg::mcap::WriterOptions{.profile = std::string(rsg::app::header_profile(profile_)),
                                                    .library = "rsg_record",
                                                    .chunk_bytes = options_.chunk_bytes,
-                                                   .sync = options_.fsync});
+                                                   .sync = options_.fsync,
+                                                   .exclusive = true});
     const auto channels = rsg::app::add_channels(*writer_, profile_, options_.topic, options_.status_topic);
     if (options_.triggered() &&
         (channels.robot_state != channels_.robot_state || channels.status != channels_.status))
@@ -253,11 +359,21 @@ class Recording {
     if (split_bytes_ != 0) spdlog::info("writing {}", path.string());
   }
 
-  void finish_event() {
+  // What ends the current event: its --post, or its own length bound.
+  std::string_view end_bound() const {
+    return event_end_ == event_start_ + event_max_ns_ ? "--event-max-duration" : "";
+  }
+
+  /// `bound`: why the event was cut short ("" when it ended by --post).
+  void finish_event(std::string_view bound) {
     const fs::path path = next_path_of(files - 1);
     const std::uint64_t before = messages;
     finish_file(false);
-    spdlog::info("event {} recorded: {} ({} messages)", events - 1, path.string(), messages - before);
+    if (bound.empty())
+      spdlog::info("event {} recorded: {} ({} messages)", events - 1, path.string(), messages - before);
+    else
+      spdlog::warn("event {} closed at {}: {} ({} messages); a trigger after this starts a new event",
+                   events - 1, bound, path.string(), messages - before);
   }
 
   /// `last`: no file follows (the recording ends), so retention keeps no room for one.
@@ -284,7 +400,10 @@ class Recording {
     const std::size_t next_files = last ? 0 : 1;
     const auto max_bytes = static_cast<std::uint64_t>(options_.max_mb * 1e6);
     const auto max_age = std::chrono::duration<double>(options_.max_age_s);
-    while (!finished_.empty()) {
+    // --trigger: the newest event is never removed, whatever the limits: what an attack (or an
+    // incident) left is the file an operator needs.
+    const std::size_t keep = options_.triggered() ? 1 : 0;
+    while (finished_.size() > keep) {
       const Finished& oldest = finished_.front();
       const char* why = nullptr;
       if (options_.max_files != 0 && finished_.size() + next_files > options_.max_files)
@@ -350,8 +469,9 @@ class Recording {
     last_log_time_ = log_time;
     if (sample.channel == channels_.robot_state) ++states_written;
     if (options_.triggered()) {
-      if (writer_ && log_time > event_end_) finish_event();
+      if (writer_ && log_time > event_end_) finish_event(end_bound());
       if (writer_) write_to_file(sample, log_time);
+      if (writer_ && writer_->totals().file_bytes >= event_max_bytes_) finish_event("--event-max-size");
       // Kept during an event too: an event soon after this one gets its whole --pre window as well.
       keep_for_an_event(sample, log_time);
       return;
@@ -406,12 +526,15 @@ class Recording {
   rsg::app::CdrSerializer serializer_;
   bool numbered_;  // FILE_0.mcap, FILE_1.mcap, ... (--split-size, --trigger)
   std::uint64_t pre_ns_, post_ns_, buffer_bytes_;
+  std::uint64_t event_max_ns_, event_max_bytes_;
+  std::string run_stamp_;  // the run's start: its files' names (next_path_of)
   rsg::app::PublicationOrder order_;
   std::uint64_t last_log_time_ = 0;
   std::deque<Finished> finished_;  // with --split-size or --trigger, oldest first, not yet removed
   std::deque<rsg::app::PublicationOrder::Sample> pre_;  // --trigger: the --pre window, oldest first
   std::uint64_t pre_bytes_ = 0;
   bool warned_buffer_ = false;
+  std::uint64_t event_start_ = 0;         // --trigger: the log time of the current event's first trigger
   std::uint64_t event_end_ = 0;           // --trigger: the log time up to which the current event records
   std::optional<bool> link_up_;           // --trigger link-down: as the last status sample said
   std::optional<std::uint64_t> invalid_;  // --trigger invalid: the last status sample's total
@@ -425,7 +548,7 @@ void add_options(CLI::App& app, Options& options) {
                  "channel metadata rosbag2 expects)");
   app.add_option("--duration", options.duration_s,
                  "Stop after this many seconds (default: until SIGINT/SIGTERM)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(rsg::app::non_negative_number());
   app.add_option(
          "--recover", options.recover,
          "Do not record: write what FILE (a recording whose recorder was killed) holds up to its last "
@@ -433,31 +556,46 @@ void add_options(CLI::App& app, Options& options) {
       ->check(CLI::ExistingFile);
   auto* split =
       app.add_option("--split-size", options.split_mb,
-                     "Start a new file when one reaches this many MB: FILE_0.mcap, FILE_1.mcap, ...")
-          ->check(CLI::NonNegativeNumber);
+                     "Start a new file when one reaches this many MB: FILE_<run's start, UTC>_000000.mcap, "
+                     "..._000001.mcap, ... (names that sort by time; a restarted recorder never overwrites "
+                     "an earlier run's files)")
+          ->check(rsg::app::non_negative_number());
   // Record only around events, as the gateway's flight recorder keeps its datagrams: a recorder left
   // running writes nothing until something happens.
   auto* trigger =
       app.add_option("--trigger", options.triggers,
                      "Record only around events: signal (SIGUSR1), link-down (the gateway's status says "
                      "its link went down), invalid (it counted invalid frames since its previous status); "
-                     "each event gets a file FILE_0.mcap, FILE_1.mcap, ... with --pre "
-                     "seconds before it and --post after (an event meanwhile extends it)")
+                     "each event gets a file FILE_<run's start, UTC>_000000.mcap, ... with --pre "
+                     "seconds before it and --post after (an event meanwhile extends it, within "
+                     "--event-max-duration and --event-max-size)")
           ->check(CLI::IsMember({"signal", "link-down", "invalid"}))
           ->delimiter(',')
           ->excludes(split);
   app.add_option("--pre", options.pre_s, "With --trigger: seconds recorded before an event")
-      ->check(CLI::NonNegativeNumber)
+      ->check(rsg::app::non_negative_number())
       ->capture_default_str()
       ->needs(trigger);
   app.add_option("--post", options.post_s, "With --trigger: seconds recorded after an event")
-      ->check(CLI::NonNegativeNumber)
+      ->check(rsg::app::non_negative_number())
+      ->capture_default_str()
+      ->needs(trigger);
+  app.add_option("--event-max-duration", options.event_max_s,
+                 "With --trigger: an event that triggers keep extending is closed (and kept) this many "
+                 "seconds after its first trigger; a trigger after that starts a new event")
+      ->check(rsg::app::positive_number())
+      ->capture_default_str()
+      ->needs(trigger);
+  app.add_option("--event-max-size", options.event_max_mb,
+                 "With --trigger: an event's file is closed (and kept) when it reaches this many MB, or half "
+                 "of --max-size if that is less; a trigger after that starts a new event")
+      ->check(rsg::app::positive_number())
       ->capture_default_str()
       ->needs(trigger);
   app.add_option("--trigger-buffer", options.trigger_buffer_mb,
                  "With --trigger: MB of memory the --pre window may take (a faster stream keeps less than "
                  "--pre seconds, with a warning)")
-      ->check(CLI::Range(0.1, 4096.0))
+      ->check(rsg::app::number_in(0.1, 4096.0))
       ->capture_default_str()
       ->needs(trigger);
   // Retention, as rosbag2 users know it from storage limits: a recorder left running keeps the
@@ -465,18 +603,19 @@ void add_options(CLI::App& app, Options& options) {
   // or --trigger).
   app.add_option(
          "--max-files", options.max_files,
-         "With --split-size or --trigger: keep at most this many files (the one being written included), "
-         "removing the oldest")
+         "With --split-size or --trigger: keep at most this many files of FILE_* (the one being written "
+         "included, an earlier run's counted too), removing the oldest; with --trigger the newest event is "
+         "never removed")
       ->check(CLI::Range(std::size_t{2}, std::numeric_limits<std::size_t>::max()));
   app.add_option(
          "--max-size", options.max_mb,
          "With --split-size or --trigger: keep the files within about this many MB together, removing "
          "the oldest (room is kept for one more --split-size file)")
-      ->check(CLI::PositiveNumber);
+      ->check(rsg::app::positive_number());
   app.add_option("--max-age", options.max_age_s,
                  "With --split-size or --trigger: remove a finished file this many seconds after it was "
                  "finished")
-      ->check(CLI::PositiveNumber);
+      ->check(rsg::app::positive_number());
   app.add_option("--chunk-size", options.chunk_bytes,
                  "Finish a chunk when its records reach this many bytes before compression (or span 1 s): "
                  "smaller chunks lose less to a crash and seek finer, compress worse")
@@ -601,10 +740,9 @@ int run(const Options& options, rsg::app::Profile profile) {
   if (!matched_writers.ever_matched()) {
     // An empty file and exit 0 would look like a recording of an idle robot.
     matched_writers.explain_if_unmatched(readers.state());
-    spdlog::error("no writer of '{}' matched in {:.1f} s (see the warnings above): {} holds no state",
-                  options.topic,
+    spdlog::error("no writer of '{}' matched in {:.1f} s (see the warnings above): {}", options.topic,
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-                  options.out.string());
+                  recording.written());
     return kExitFailure;
   }
   return exit_code;

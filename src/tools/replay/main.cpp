@@ -20,6 +20,7 @@
 
 #include "app/dds_options.hpp"
 #include "app/discovery_cli.hpp"
+#include "app/number_checks.hpp"
 #include "app/recording.hpp"
 #include "app/stop_on_signal.hpp"
 #include "app/tool_main.hpp"
@@ -234,7 +235,7 @@ void add_options(CLI::App& app, Options& options) {
   rsg::app::add_profile_options(app, options.profiles, options.participant_profile);
   rsg::app::add_discovery_options(app, options.discovery);
   app.add_option("--speed", options.speed, "Play this many times faster than recorded")
-      ->check(CLI::PositiveNumber)
+      ->check(rsg::app::positive_number())
       ->capture_default_str();
   app.add_flag("--loop", options.loop,
                "Play the file again and again until SIGINT/SIGTERM, each pass one mean gap between samples "

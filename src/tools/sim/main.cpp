@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "app/file_options.hpp"
+#include "app/number_checks.hpp"
 #include "app/stop_on_signal.hpp"
 #include "app/tool_main.hpp"
 #include "capture/pcap_file.hpp"
@@ -96,11 +97,11 @@ void add_options(CLI::App& app, Options& options, rsg::tools::sim::SimConfig& co
       })
       ->required();
   app.add_option("--rate", config.rate_hz, "Frames per second")
-      ->check(CLI::Range(1e-3, 1e6))
+      ->check(rsg::app::number_in(1e-3, 1e6))
       ->capture_default_str();
   auto* count = app.add_option("--count", options.count, "Send this many frames, then exit");
   app.add_option("--duration", options.duration_s, "Send for this many seconds, then exit")
-      ->check(CLI::PositiveNumber)
+      ->check(rsg::app::positive_number())
       ->excludes(count);
   app.add_option("--seed", config.seed, "Seed of the motion and of the random faults")->capture_default_str();
 
@@ -123,7 +124,7 @@ void add_options(CLI::App& app, Options& options, rsg::tools::sim::SimConfig& co
   rsg::tools::sim::FaultConfig& fault = config.faults;
   const auto probability = [&](const char* name, double& value, const char* what) {
     faults->add_option(name, value, std::string("Probability that a frame is ") + what)
-        ->check(CLI::Range(0.0, 1.0));
+        ->check(rsg::app::number_in(0.0, 1.0));
   };
   probability("--drop", fault.drop, "not sent");
   probability("--duplicate", fault.duplicate, "sent twice");
@@ -162,7 +163,7 @@ void add_options(CLI::App& app, Options& options, rsg::tools::sim::SimConfig& co
       replay->add_option("--replay", options.replay_path,
                          "Replay the SEND_BUF datagrams of this pcap/pcapng file at their original timing");
   replay->add_option("--speed", options.replay.speed, "Replay this many times faster")
-      ->check(CLI::Range(1e-3, 1e6))
+      ->check(rsg::app::number_in(1e-3, 1e6))
       ->needs(file)
       ->capture_default_str();
   replay->add_flag("--loop", options.replay.loop, "Start the capture over at its end, until stopped")

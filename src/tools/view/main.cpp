@@ -73,6 +73,7 @@ void add_options(CLI::App& app, Options& options) {
       })
       ->capture_default_str();
   rsg::app::add_monitor_options(app, options, "serves none");
+  rsg::app::add_log_level_option(app);
   app.add_option("--max-clients", options.server.max_clients, "WebSocket clients served at once")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();

@@ -7,9 +7,11 @@ gateway to rsg_echo. Each case is one ctest test (record.<case>), in its own DDS
 
 import json
 import os
+import re
 import resource
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -17,7 +19,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[2]
-from harness import (UdpRelay, check, free_udp_port, main, read_json_lines, receive_timed,  # noqa: E402
+from harness import (UdpRelay, check, free_udp_port, main, read_json, read_json_lines, receive_timed,  # noqa: E402
                      timed_receiver, wait_for, wait_for_stats, wait_matched)
 from replay_target import second_gateway_with_echo  # noqa: E402
 
@@ -71,6 +73,18 @@ def run_sim(h, port, count, rate, *flags):
 
 
 SELECTIONS = ["--every", "1:q,dq,time", "--every", "3:g0", "--every", "10:all"]
+
+
+def set_files(h, stem):
+    """The files of a numbered set (--split-size, --trigger), oldest first: their names sort by time
+    (STEM_<run's start>_<index>.mcap)."""
+    name = re.compile(rf"{re.escape(stem)}_\d{{8}}T\d{{6}}\.\d{{3}}Z_\d{{6}}\.mcap")
+    return sorted(path for path in h.dir.glob(f"{stem}_*.mcap") if name.fullmatch(path.name))
+
+
+def index_of(path):
+    """The index of a numbered file in its run (the last part of its name)."""
+    return int(path.stem.rsplit("_", 1)[1])
 
 
 def reference_reader(h):
@@ -247,8 +261,9 @@ def split_and_view(h):
     wait_for_stats(stats, lambda s: s["frames_published"] >= 1500, "the gateway to publish every frame")
     time.sleep(1.0)
     check(h.stop("record", rec) == 0 and h.stop("record_view", rec2) == 0, "a recorder did not exit 0")
-    files = sorted(h.dir.glob("run_*.mcap"), key=lambda path: int(path.stem.split("_")[1]))
+    files = set_files(h, "run")
     check(len(files) >= 2, f"--split-size 0.1 gave {len(files)} files")
+    check([index_of(path) for path in files] == list(range(len(files))), f"the split files: {files}")
     states = 0
     for path in files:
         check(path.stat().st_size < 600_000, f"{path.name} is {path.stat().st_size} bytes")
@@ -479,10 +494,141 @@ def no_writer(h):
     gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--partition", "robot1")
     out = h.dir / "run.mcap"
     rec = recorder(h, "record", out, "--partition", "robot2", "--duration", "4")
+    # A triggered recorder writes no file before an event: it says so, naming none.
+    triggered = recorder(h, "record_trigger", h.dir / "trig.mcap", "--partition", "robot2", "--duration", "4",
+                         "--trigger", "signal")
     status = h.wait("record", rec, 30)
     err = stderr_of(h, "record")
     check(status == 1, f"rsg_record exited {status} without a writer: {err}")
-    check("no writer of 'robot_state' matched" in err and "holds no state" in err and "robot1" in err, err)
+    check("no writer of 'robot_state' matched" in err and f"{out} holds no state" in err and "robot1" in err, err)
+    status = h.wait("record_trigger", triggered, 30)
+    err = stderr_of(h, "record_trigger")
+    check(status == 1 and "no writer of 'robot_state' matched" in err and "no file was written" in err
+          and "trig.mcap" not in err and not list(h.dir.glob("trig*")), f"--trigger without a writer: {status}: {err}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+def restart(h):
+    """A recorder restarted on the same --out (as compose's restart: on-failure does) never overwrites
+    a file: the second run's files take new names, which sort after the first run's; retention
+    counts both runs' files, removing the oldest first (the first run's), so that --max-files holds
+    across the restart; a file of the directory that is not of the set stays. The same --out of a
+    single file twice: the second recorder refuses to start rather than overwrite it."""
+    port = free_udp_port()
+    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000")
+    out = h.dir / "robot.mcap"
+    flags = ["--split-size", "0.1", "--max-files", "3", "--chunk-size", "65536", "--status-topic", ""]
+    # Not the recorder's: a name that only starts like the set's, and an older rsg's numbering.
+    (h.dir / "robot_notes.mcap").write_bytes(b"notes")
+    legacy = h.dir / "robot_7.mcap"
+    legacy.write_bytes(b"an older rsg's file")
+    first = recorder(h, "record1", out, *flags)
+    wait_matched(h, stats, ["record1"], "rsg_record")
+    run_sim(h, port, 1000, 1000)
+    wait_for_stats(stats, lambda s: s["frames_published"] >= 1000, "the first 1000 frames")
+    time.sleep(1.0)
+    check(h.stop("record1", first) == 0, f"the first recorder did not exit 0: {stderr_of(h, 'record1')}")
+    run1 = set_files(h, "robot")
+    stamps1 = {path.stem.rsplit("_", 1)[0] for path in run1}
+    check(len(run1) == 3 and len(stamps1) == 1, f"the first run kept {[p.name for p in run1]}")
+    check(not legacy.exists() and f"removed {legacy} (--max-files)" in stderr_of(h, "record1"),
+          f"the older rsg's file of the set was not counted (removed first): {stderr_of(h, 'record1')}")
+    before = {path: path.stat().st_ino for path in run1}
+
+    second = recorder(h, "record2", out, *flags)
+    wait_matched(h, stats, ["record2"], "rsg_record")
+    check("3 earlier files of" in stderr_of(h, "record2"), f"the restart did not count the earlier files: "
+          f"{stderr_of(h, 'record2')}")
+    run_sim(h, port, 1000, 1000)
+    wait_for_stats(stats, lambda s: s["frames_published"] >= 2000, "the next 1000 frames")
+    time.sleep(1.0)
+    check(h.stop("record2", second) == 0, f"the second recorder did not exit 0: {stderr_of(h, 'record2')}")
+    after = set_files(h, "robot")
+    names = [path.name for path in after]
+    check(len(after) == 3, f"--max-files 3 across the restart left {names}")
+    run2 = [path for path in after if path not in before]
+    check(run2 and all(path.name > max(p.name for p in run1) for path in run2),
+          f"the second run's files {[p.name for p in run2]} do not sort after the first's {[p.name for p in run1]}")
+    for path in after:
+        if path in before:
+            check(path.stat().st_ino == before[path], f"{path.name} was rewritten")
+    removed = [path for path in run1 if path not in after]
+    check(removed and removed == run1[:len(removed)], f"retention removed {removed}, not the oldest of {run1}")
+    for path in after:
+        node_check(h, path)
+    check((h.dir / "robot_notes.mcap").read_bytes() == b"notes", "a file not of the set was touched")
+    print(f"[{h.name}] restart: first run {[p.name for p in run1]}, then {names}", flush=True)
+
+    # One file, twice: the second refuses, the first stays as it was.
+    single = h.dir / "single.mcap"
+    status = h.run("single1", [h.binary("rsg_record"), "--domain", str(h.domain), "--out", str(single),
+                               "--duration", "1", "--status-topic", ""])
+    size = single.stat().st_size
+    status = h.run("single2", [h.binary("rsg_record"), "--domain", str(h.domain), "--out", str(single),
+                               "--duration", "1", "--status-topic", ""])
+    err = stderr_of(h, "single2")
+    check(status == 1 and "will not overwrite" in err and single.stat().st_size == size,
+          f"a second recorder on {single.name}: exit {status}: {err}")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+
+
+def trigger_bounds(h):
+    """Issue 51's attack on --trigger invalid: one 14-byte junk datagram every 1.5 s from an allowed
+    address, beside the robot's stream, with `--pre 1 --post 2 --max-size 5 --max-files 3`. Each
+    datagram extends the event, which grew past --max-size and was then removed by retention: no
+    file left. Now an event is closed, and kept, at its own bound (--event-max-size, at most half of
+    --max-size; --event-max-duration), the next trigger starts a new event, retention never removes
+    the newest event, and the files together stay within --max-size.
+
+    The control: a recorder without the bounds (--event-max-size and --event-max-duration large, no
+    --max-size) records the same attack as one event extended by every datagram: the attack keeps an
+    event open."""
+    port = free_udp_port()
+    gateway, stats = h.gateway("gateway", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000")
+    bounded = recorder(h, "bounded", h.dir / "bounded.mcap", "--trigger", "invalid", "--pre", "1", "--post", "2",
+                       "--max-size", "5", "--max-files", "3")
+    open_ended = recorder(h, "open", h.dir / "open.mcap", "--trigger", "invalid", "--pre", "1", "--post", "2",
+                          "--event-max-size", "10000", "--event-max-duration", "10000")
+    wait_matched(h, stats, ["bounded", "open"], "rsg_record")
+    # Every field in every frame (about 2 KB a message): the events reach their size bound in seconds.
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--duration", "16",
+                          "--every", "1:all"])
+    wait_for_stats(stats, lambda s: s["link_up"], "the robot's stream")
+    junk = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sent = 0
+    try:
+        deadline = time.monotonic() + 12
+        while time.monotonic() < deadline:
+            junk.sendto(b"\x00" * 14, ("127.0.0.1", port))
+            sent += 1
+            time.sleep(1.5)
+    finally:
+        junk.close()
+    check(h.wait("sim", sim, 30) == 0, "rsg_sim failed")
+    time.sleep(3.0)  # the last event's --post and the order's hold
+    for label, process in (("bounded", bounded), ("open", open_ended)):
+        check(h.stop(label, process) == 0, f"{label} did not exit 0: {stderr_of(h, label)}")
+    final = read_json(stats)
+    check(sum(final["invalid"].values()) >= sent - 1, f"the gateway counted {final['invalid']} of {sent} junk datagrams")
+
+    err = stderr_of(h, "open")
+    check("; 1 event (" in err and err.count("event 0 extended") >= 3,
+          f"the control: the attack should keep one event open, extended by every datagram: {err[-1500:]}")
+    err = stderr_of(h, "bounded")
+    files = set_files(h, "bounded")
+    sizes = [path.stat().st_size for path in files]
+    check(files, f"the attack left no event file: {err[-1500:]}")
+    check("closed at --event-max-size" in err, f"no event was closed at its bound: {err[-1500:]}")
+    summary = re.search(r"; (\d+) events? \((\d+) triggers?\)", err)
+    events = int(summary.group(1)) if summary else 0
+    check(events >= 2, f"one event for the whole attack: {err[-1500:]}")
+    # An event file ends at the first chunk (1 MiB) after its bound: 2.5 MB + a chunk.
+    check(all(size <= 2_500_000 + 1_200_000 for size in sizes) and sum(sizes) <= 5_000_000 + 1_200_000,
+          f"event files {dict(zip((p.name for p in files), sizes))}")
+    for path in files:
+        node_check(h, path)
+    print(f"[{h.name}] {sent} junk datagrams: {events} events, kept {dict(zip((p.name for p in files), sizes))}; "
+          f"the control kept one event open", flush=True)
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
 
 
@@ -507,14 +653,16 @@ def retention(h):
     check(h.stop("record", rec) == 0 and h.stop("record_sized", rec2) == 0 and h.stop("record_aged", rec3) == 0,
           "a recorder did not exit 0")
     # The first file was finished early in the stream, well over a second before the stop.
-    check(not (h.dir / "aged_0.mcap").exists() and "aged_0.mcap (--max-age)" in stderr_of(h, "record_aged"),
-          f"--max-age 1 kept aged_0.mcap: {stderr_of(h, 'record_aged')}")
-    files = sorted(h.dir.glob("run_*.mcap"), key=lambda path: int(path.stem.split("_")[1]))
-    indexes = [int(path.stem.split("_")[1]) for path in files]
+    aged_files = set_files(h, "aged")
+    check(aged_files and index_of(aged_files[0]) > 0 and "_000000.mcap (--max-age)" in stderr_of(h, "record_aged"),
+          f"--max-age 1 kept the first file: {aged_files}: {stderr_of(h, 'record_aged')}")
+    files = set_files(h, "run")
+    indexes = [index_of(path) for path in files]
     err = stderr_of(h, "record")
     check(len(files) == 3 and indexes == list(range(indexes[0], indexes[0] + 3)) and indexes[0] >= 3,
           f"--max-files 3 left {[path.name for path in files]}: {err}")
-    check(f"removed {h.dir / 'run_0.mcap'} (--max-files)" in err and f"; {indexes[0]} oldest files removed" in err, err)
+    first = str(files[0]).rsplit("_", 1)[0] + "_000000.mcap"
+    check(f"removed {first} (--max-files)" in err and f"; {indexes[0]} oldest files removed" in err, err)
     kept = [node_check(h, path)["states"] for path in files]
     skip = count - sum(kept)
     for path, states in zip(files, kept):
@@ -576,8 +724,9 @@ def trigger(h):
     for label, process in (("record", rec), ("record_down", down), ("record_small", small),
                            ("record_invalid", invalid)):
         check(h.stop(label, process) == 0, f"{label} did not exit 0: {stderr_of(h, label)}")
-    files = sorted(path.name for path in h.dir.glob("*.mcap") if not path.name.startswith("down_"))
-    check(files == ["invalid_0.mcap", "run_0.mcap", "run_1.mcap", "small_0.mcap"], f"the events wrote {files}")
+    files = {stem: [index_of(path) for path in set_files(h, stem)] for stem in ("invalid", "run", "small")}
+    check(files == {"invalid": [0], "run": [0, 1], "small": [0]} and len(list(h.dir.glob("*.mcap"))) == 4 +
+          len(set_files(h, "down")), f"the events wrote {sorted(path.name for path in h.dir.glob('*.mcap'))}")
     check("; 2 events (2 triggers)" in stderr_of(h, "record"), stderr_of(h, "record"))
 
     def in_order(path, values=False):
@@ -588,24 +737,24 @@ def trigger(h):
             node_check(h, path, "--frames", record, "--skip", seen["first_sequence"] - 1)
         return seen
 
-    signalled = in_order(h.dir / "run_0.mcap", values=True)
+    signalled = in_order(set_files(h, "run")[0], values=True)
     check(1500 <= signalled["states"] <= 2500 and signalled["statuses"] >= 1,
           f"--pre 1 --post 1 of a 1 kHz stream: {signalled}")
-    again = in_order(h.dir / "run_1.mcap")
+    again = in_order(set_files(h, "run")[1])
     check(again["states"] >= 800 and again["first_sequence"] < signalled["first_sequence"] + signalled["states"],
           f"the second event's file {again} after the first's {signalled}")
-    downs = sorted(h.dir.glob("down_*.mcap"), key=lambda path: int(path.stem.split("_")[1]))
+    downs = set_files(h, "down")
     last = in_order(downs[-1], values=True)
     check(last["first_sequence"] - 1 + last["states"] == count and last["statuses"] >= 1,
           f"the link-down event's file of a stream that stopped at frame {count}: {last}")
     check("the link went down: event 0" in stderr_of(h, "record_down"), stderr_of(h, "record_down"))
-    flooded = in_order(h.dir / "invalid_0.mcap")
+    flooded = in_order(set_files(h, "invalid")[0])
     err = stderr_of(h, "record_invalid")
     check("invalid frames: event 0" in err and "; 1 event (" in err and flooded["statuses"] >= 1,
           f"{flooded}: {err}")
     # Unbounded, 2 s before the event and 1 s after; 0.5 MB holds well under a second of full frames
     # (the last 0.5 s before the event wait in the publication-order hold, not in the window).
-    bounded = in_order(h.dir / "small_0.mcap")
+    bounded = in_order(set_files(h, "small")[0])
     err = stderr_of(h, "record_small")
     check(bounded["states"] < 2500 and "--trigger-buffer 0.5 MB holds" in err
           and "samples of the --pre window left out (--trigger-buffer)" in err, f"{bounded}: {err}")
@@ -614,7 +763,7 @@ def trigger(h):
 
 CASES = {f.__name__: f for f in (reference_reader, sigkill, write_errors, replay_roundtrip, split_and_view, duration,
                                  ros2_profile, chunk_size_fsync, drain_on_sigterm, mid_stream_under_load, no_writer,
-                                 retention, trigger)}
+                                 retention, trigger, restart, trigger_bounds)}
 
 if __name__ == "__main__":
     sys.exit(main(f"record_{CASE}", CASES[CASE]))
