@@ -270,8 +270,9 @@ void Ingress::request_selection(const transport::Endpoint& robot) {
   // most once a second), so it may log.
   if (encoded && socket_.send_to(std::span(request).first(encoded.size), robot))
     requester_->log_sent(robot.to_string(), source_.size() ? source_.to_string() : std::string());
-  else
-    spdlog::warn("could not send the selection request to {}", robot.to_string());
+  else if (const auto n = request_failed_log_.take(Clock::now()))
+    spdlog::warn("could not send the selection request to {} ({} times since the last such line)",
+                 robot.to_string(), n);
 }
 
 void Ingress::set_sources(SourceFilter sources) { options_.sources = std::move(sources); }

@@ -189,7 +189,7 @@ class Ingress {
   // Counted once a second, logged once a minute: a misconfigured robot or a flood from outside
   // allow-from would otherwise write a line a second (86,400 a day).
   std::uint64_t counted_rejected_source_ = 0, counted_invalid_ = 0, counted_standard_dropped_ = 0;
-  app::RepeatedLog rejected_source_log_, invalid_log_, standard_dropped_log_;
+  app::RepeatedLog rejected_source_log_, invalid_log_, standard_dropped_log_, request_failed_log_;
 };
 
 }  // namespace rsg::gateway
