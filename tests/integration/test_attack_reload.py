@@ -62,7 +62,7 @@ def body(h):
         check(gateway.poll() is None, f"{what}: the gateway exited {gateway.poll()}")
         # The outsider's frames: none published unless the reload was the control's.
         published = read_json(stats)["frames_published"]
-        send_frames(port, FRAMES, 200, source="127.0.0.2", first=1000 * sum(expected.values()))
+        send_frames(port, FRAMES, 200, source="127.0.0.2", first=1000 * int(sum(expected.values())))
         if result == "applied":
             return wait_for_stats(stats, lambda s: s["frames_published"] == published + FRAMES,
                                   f"{what}: the outsider's frames to be published")
