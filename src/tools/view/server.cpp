@@ -222,35 +222,33 @@ class WsSession : public std::enable_shared_from_this<WsSession>, public app::Co
     schedule_tick();
   }
 
-  /// Room for this client: under both caps, or an idle client closed to make it -- of this address
-  /// at its cap, else of the address holding the most clients; the oldest of them. A client that
-  /// subscribed, or is within its grace, is never closed for another; with none idle this one is
-  /// refused (false). An address that holds clients already takes a place of another address only
-  /// from one holding at least two more: two attackers' addresses renewing their clients would
-  /// otherwise close each other's in turn for ever, every renewed one a fresh grace.
+  /// Room for this client: under both caps, or an idle client of the address holding the most
+  /// clients closed to make it, the oldest of them. A client that subscribed, or is within its
+  /// grace, is never closed for another; with none idle this one is refused (false). A client of
+  /// an address at its cap is refused, and an address that holds clients already takes a place of
+  /// another address only from one holding at least two more: an attacker renewing its clients
+  /// would otherwise close its own or another address's idle ones in turn for ever, every renewed
+  /// one within a fresh grace, so that none would ever be idle for a newcomer.
   bool admit() {
     std::map<net::ip::address, std::size_t> held;
     for (const auto& session : hub_.sessions) ++held[session->address()];
     const std::size_t mine = held[address_];
-    const bool at_address_cap = mine >= hub_.options.max_clients_per_address;
-    if (!at_address_cap && hub_.sessions.size() < hub_.options.max_clients) return true;
+    if (mine >= hub_.options.max_clients_per_address) {
+      hub_.count(LimitEvent::kClientsPerAddress, "already " + std::to_string(mine) + " clients from " +
+                                                     address_.to_string() + ": refused " + peer_);
+      return false;
+    }
+    if (hub_.sessions.size() < hub_.options.max_clients) return true;
     std::shared_ptr<WsSession> victim;
     for (const auto& session : hub_.sessions) {
-      if (!session->idle()) continue;
-      if (at_address_cap ? session->address() != address_ : mine > 0 && held[session->address()] < mine + 2)
-        continue;
+      if (!session->idle() || (mine > 0 && held[session->address()] < mine + 2)) continue;
       if (!victim || held[session->address()] > held[victim->address()] ||
           (held[session->address()] == held[victim->address()] && session->number() < victim->number()))
         victim = session;
     }
-    if (at_address_cap)
-      hub_.count(LimitEvent::kClientsPerAddress,
-                 "already " + std::to_string(held[address_]) + " clients from " + address_.to_string() +
-                     ": " + (victim ? "closed its longest idle one" : "refused " + peer_));
-    else
-      hub_.count(LimitEvent::kClients, "already " + std::to_string(hub_.sessions.size()) + " clients: " +
-                                           (victim ? "closed an idle one of " + victim->address().to_string()
-                                                   : "refused " + peer_));
+    hub_.count(LimitEvent::kClients,
+               "already " + std::to_string(hub_.sessions.size()) + " clients: " +
+                   (victim ? "closed an idle one of " + victim->address().to_string() : "refused " + peer_));
     if (!victim) return false;
     victim->finish();
     return true;

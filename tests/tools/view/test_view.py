@@ -337,8 +337,8 @@ def attack_chatty_clients(h):
     a client sends never makes it less idle, and an address holds at most --max-clients-per-address
     (4) clients, so two addresses hold at most 8 of --max-clients (16). Once they are past the grace
     a new client has to subscribe (Server::kSubscribeGrace, 10 s), 12 legitimate Foxglove clients
-    from 12 other addresses arrive one after another, each subscribing 2 s after it connected (a
-    person picking topics): every one gets its 200 messages and none is closed -- a client within
+    from 12 other addresses arrive 0.5 s apart, each subscribing 2 s after it connected (a person
+    picking topics): every one gets its 8,000 messages and none is closed -- a client within
     its grace or with a subscription never makes room, the chatty idle ones do. The control that
     shows the attack is real: the chatty clients held places (at least 8 open at once) and asked for
     more than the per-address cap allows (`clients_per_address` counted); and the legitimate
@@ -352,7 +352,9 @@ def attack_chatty_clients(h):
     time.sleep(11.0)  # past the grace: the chatty clients are idle now, whatever they send
     late = []
     for i in range(12):
-        late.append(h.start(f"late{i}", [node(), ATTACK, "late", url, f"127.0.0.{10 + i}", "2000", "200", "15000"]))
+        # 8,000 messages (the two RobotState channels at 1 kHz: 4 s): the twelve overlap, so that
+        # the last ones find every place taken.
+        late.append(h.start(f"late{i}", [node(), ATTACK, "late", url, f"127.0.0.{10 + i}", "2000", "8000", "20000"]))
         time.sleep(0.5)
     for i, client in enumerate(late):
         check(h.wait(f"late{i}", client, 30) == 0,
