@@ -10,7 +10,8 @@
   never counted, never deleted, and no real dump is deleted because of them. Before: each real
   dump was deleted at the next one.
 - The link flaps' log: the first "link down" line at once, then counts, not a line per flap.
-  Before: two lines per flap.
+  Before: two lines per flap. The same for 3.5 s of datagrams from outside allow-from and of
+  invalid frames from the allowed address: one line each. Before: a line a second each.
 - A --pcap-dir others can write (mode 1777, a shared folder where symlinks could be planted under
   the next dump's name): the gateway refuses to start, exit 2, naming the folder; the control,
   the same folder made the gateway's own (0755), starts. (A symlink under the dump's name is never
@@ -22,7 +23,7 @@ import socket
 import sys
 import time
 
-from attack_support import checked_scrape, valid_frame
+from attack_support import JunkFlood, checked_scrape, valid_frame
 from harness import check, free_udp_port, main, wait_for, wait_for_stats
 from metrics_support import free_tcp_port, http_get, value_of
 
@@ -121,6 +122,22 @@ def body(h):
     text = (h.dir / "gateway.err").read_text(errors="replace")
     down_lines = sum(1 for line in text.splitlines() if "link down (" in line)
     check(down_lines <= 2, f"{down_lines} 'link down' lines for {1 + FLAPS} link downs")
+    # Steady bad input for 3.5 s (over three status periods, each of which logged a line before):
+    # datagrams from outside allow-from, and invalid ones from the allowed address (a misconfigured
+    # robot). One line each, then a count a minute.
+    floods = [JunkFlood(port, source="127.0.0.2", rate=500), JunkFlood(port, source="127.0.0.1", rate=500)]
+    for flood in floods:
+        flood.start()
+    time.sleep(3.5)
+    for flood in floods:
+        flood.stop()
+    wait_for_stats(stats, lambda s: s["rejected_source"] >= 1000 and sum(s["invalid"].values()) >= 1000,
+                   "the bad input to be counted")
+    time.sleep(1.5)  # two more status periods
+    text = (h.dir / "gateway.err").read_text(errors="replace")
+    foreign, invalid = text.count("from outside --allow-from"), text.count("rejected invalid frames")
+    check(foreign == 1 and invalid == 1, f"{foreign} lines for datagrams from outside allow-from, {invalid} for "
+                                         "invalid frames, over 3.5 s of each")
     stream.socket.close()
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0 on SIGTERM")
 
