@@ -61,6 +61,19 @@ PcapWriter::PcapWriter(const std::string& path)
     throw EnvironmentError("cannot write '" + path + "': " + std::string(pcap_geterr(dead_.get())));
 }
 
+PcapWriter::PcapWriter(std::FILE* file, const std::string& path)
+    : path_(path), dead_(pcap_open_dead(DLT_RAW, static_cast<int>(kMaxIpUdpHeader + kMaxUdpPayload))) {
+  if (!dead_) {
+    std::fclose(file);
+    throw EnvironmentError("cannot write '" + path + "': libpcap refused raw IP");
+  }
+  // Owns `file` from here on, closed with it. When it fails writing the header, libpcap has closed
+  // `file` itself (pcap_setup_dump), so it is not closed again here.
+  dumper_.reset(pcap_dump_fopen(dead_.get(), file));
+  if (!dumper_)
+    throw EnvironmentError("cannot write '" + path + "': " + std::string(pcap_geterr(dead_.get())));
+}
+
 bool PcapWriter::write(const UdpPacket& packet) {
   const std::size_t size = encode_raw_ip(packet.from, packet.to, packet.payload, packet_);
   if (size == 0) return false;

@@ -44,6 +44,9 @@ class PcapWriter {
  public:
   /// @throws rsg::EnvironmentError naming the file.
   explicit PcapWriter(const std::string& path);
+  /// Writes into `file`, already open for writing (the caller chose how: O_EXCL, O_NOFOLLOW), and
+  /// closes it when done; `path` names it in errors. @throws rsg::EnvironmentError naming the file.
+  PcapWriter(std::FILE* file, const std::string& path);
 
   /// False when the packet cannot be encoded (payload too large, mixed IP versions). Write errors
   /// show at `flush`.

@@ -273,6 +273,11 @@ const std::array kKeys = {
                 if (std::ranges::find(kLogLevels, level) != kLogLevels.end()) return std::string();
                 return "'" + c.log_level + "' is not one of trace, debug, info, warn, error, off";
               }},
+    ConfigKey{"reload-widens-access",
+              "Let a SIGHUP reload widen access: drop allow-from or open it to everyone, change the "
+              "participant profile or --profiles (DDS Security), data-sharing off to auto; without it such "
+              "a reload is refused, logged and counted (result=\"refused\")",
+              &GatewayConfig::reload_widens_access, [](const GatewayConfig&) { return std::string(); }},
     ConfigKey{"log-format",
               "text (one line per event, timestamped unless the journal is stderr) or json (one JSON object "
               "per line: time, level, logger, message)",
@@ -518,7 +523,10 @@ ConfigResult parse_gateway_config(std::string_view yaml_text, const GatewayConfi
       return ConfigError{line_of(root.Mark()), "expected a mapping of 'key: value' lines"};
     }
 
+    // Each key's check runs once the whole file is read: a check that reads another key (pcap-ring
+    // against expected-rate) must see that key's value from the file whatever the order of the lines.
     std::set<std::string, std::less<>> seen;
+    std::vector<std::pair<const ConfigKey*, int>> given;  // in file order, with their lines
     for (const auto& entry : root) {
       const int line = line_of(entry.first.Mark());
       if (!entry.first.IsScalar()) return ConfigError{line, "keys must be plain names"};
@@ -536,8 +544,11 @@ ConfigResult parse_gateway_config(std::string_view yaml_text, const GatewayConfi
       if (entry.second.IsNull()) return ConfigError{line, name + ": has no value"};
       if (auto error = assign(config, key->member, entry.second); !error.empty())
         return ConfigError{line, name + ": " + error};
-      if (auto error = key->check(config); !error.empty()) return ConfigError{line, name + ": " + error};
+      given.emplace_back(key, line);
     }
+    for (const auto& [key, line] : given)
+      if (auto error = key->check(config); !error.empty())
+        return ConfigError{line, std::string(key->name) + ": " + error};
     return config;
   } catch (const YAML::Exception& error) {
     const int line = line_of(error.mark);

@@ -51,6 +51,8 @@ struct GatewayConfig {
   std::string stats_file;
   std::string log_level = "info";
   std::string log_format = "text";  ///< once started: "text" or "json" (journal_log.hpp)
+  /// A SIGHUP reload may widen access (gateway.hpp, widened_access); without it such a reload is refused.
+  bool reload_widens_access = false;
 
   // Monitoring: Prometheus metrics and /healthz on HOST:PORT (metrics_server.hpp); "" : off
   std::string metrics;
@@ -154,7 +156,8 @@ class ConfigResult {
 };
 
 /// Parses a YAML configuration (a mapping of config keys) on top of `defaults`. Checks types and
-/// each value, not how keys combine (`check_config` does that once flags are merged in). Never
+/// each value once the whole document is read (so the order of the lines never matters), not how keys
+/// combine (`check_config` does that once flags are merged in). Never
 /// throws, touches no files and no network: safe to fuzz.
 ConfigResult parse_gateway_config(std::string_view yaml_text, const GatewayConfig& defaults = {});
 

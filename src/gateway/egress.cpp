@@ -108,30 +108,33 @@ void Egress::forward(const RobotState& sample) {
 
 void Egress::log_unencodable() {
   const std::uint64_t total = unencodable_.load(std::memory_order_relaxed);
-  if (total == logged_unencodable_ || !unencodable_log_.allow(Clock::now())) return;
-  spdlog::warn("{} samples of the egress topic describe no valid frame and were not sent; the last: {}: {}",
-               total - logged_unencodable_, to_string(last_encode_error_.category()),
-               last_encode_error_.message());
-  logged_unencodable_ = total;
+  const std::uint64_t n = unencodable_log_.take(Clock::now(), total - counted_unencodable_);
+  counted_unencodable_ = total;
+  if (n == 0) return;
+  spdlog::warn(
+      "{} samples of the egress topic describe no valid frame and were not sent since the last such line; "
+      "the "
+      "last: {}: {}",
+      n, to_string(last_encode_error_.category()), last_encode_error_.message());
 }
 
 void Egress::log_refused() {
-  // Each kind is logged when it first happens, then at most every 10 s with what came since.
+  // Each kind is logged when it first happens, then at most once a minute with what came since.
   const auto now = Clock::now();
   const std::uint64_t request_like = request_like_.load(std::memory_order_relaxed);
-  if (request_like != logged_request_like_ && request_like_log_.allow(now)) {
+  if (const auto n = request_like_log_.take(now, request_like - counted_request_like_))
     spdlog::warn(
         "{} samples of the egress topic select no field: their frame would read as a selection "
-        "request to the robot, so they were not sent",
-        request_like - logged_request_like_);
-    logged_request_like_ = request_like;
-  }
+        "request to the robot, so they were not sent (since the last such line)",
+        n);
+  counted_request_like_ = request_like;
   const std::uint64_t rate_limited = rate_limited_.load(std::memory_order_relaxed);
-  if (rate_limited != logged_rate_limited_ && rate_limited_log_.allow(now)) {
-    spdlog::warn("{} samples of the egress topic were not sent: more than --egress-rate {} a second",
-                 rate_limited - logged_rate_limited_, max_rate_hz_);
-    logged_rate_limited_ = rate_limited;
-  }
+  if (const auto n = rate_limited_log_.take(now, rate_limited - counted_rate_limited_))
+    spdlog::warn(
+        "{} samples of the egress topic were not sent: more than --egress-rate {} a second (since the last "
+        "such line)",
+        n, max_rate_hz_);
+  counted_rate_limited_ = rate_limited;
 }
 
 }  // namespace rsg::gateway

@@ -22,9 +22,9 @@
 #include <thread>
 #include <vector>
 
+#include "app/repeated_log.hpp"
 #include "gateway/clock.hpp"
 #include "gateway/data_sharing.hpp"
-#include "gateway/log_throttle.hpp"
 #include "rsg/dds/owned.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/robot_state.hpp"
@@ -118,12 +118,8 @@ class Egress {
   double max_rate_hz_;
   // Egress thread only: the rate-limited log of samples that are no valid frame.
   wire::FrameError last_encode_error_;
-  std::uint64_t logged_unencodable_ = 0;
-  LogThrottle unencodable_log_{std::chrono::seconds(1)};
-  std::uint64_t logged_request_like_ = 0;
-  std::uint64_t logged_rate_limited_ = 0;
-  LogThrottle request_like_log_{std::chrono::seconds(10)};
-  LogThrottle rate_limited_log_{std::chrono::seconds(10)};
+  std::uint64_t counted_unencodable_ = 0, counted_request_like_ = 0, counted_rate_limited_ = 0;
+  app::RepeatedLog unencodable_log_, request_like_log_, rate_limited_log_;
 
   std::jthread thread_;  // last: starts once everything it uses exists; named rsg-egress
 };

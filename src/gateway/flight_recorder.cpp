@@ -1,11 +1,17 @@
 #include "gateway/flight_recorder.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <ctime>
 #include <stdexcept>
 
 #include "capture/pcap_file.hpp"
+#include "gateway/errno_text.hpp"
+#include "rsg/error.hpp"
 
 namespace rsg::gateway {
 namespace {
@@ -95,7 +101,22 @@ FlightRecorder::Snapshot FlightRecorder::snapshot(std::string_view reason) {
 
 FlightRecorder::Dump FlightRecorder::write(const Snapshot& snapshot) {
   Dump result{snapshot.path, 0};
-  capture::PcapWriter writer(snapshot.path.string());
+  // A new file or none: whatever sits under the name (a file, a symlink planted to make the dump
+  // overwrite something else) is left alone and the dump fails, named. Readable by the service's
+  // group (an operator's), written by it alone.
+  const int fd = ::open(snapshot.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0640);
+  if (fd < 0) {
+    const int error = errno;
+    throw EnvironmentError("cannot create '" + snapshot.path.string() + "': " + errno_text(error) +
+                           (error == EEXIST ? ": something is there already, left alone" : ""));
+  }
+  std::FILE* file = ::fdopen(fd, "wb");
+  if (file == nullptr) {
+    const int error = errno;
+    ::close(fd);
+    throw EnvironmentError("cannot write '" + snapshot.path.string() + "': " + errno_text(error));
+  }
+  capture::PcapWriter writer(file, snapshot.path.string());
   for (const Snapshot::Datagram& datagram : snapshot.datagrams) {
     if (writer.write({datagram.time,
                       datagram.from,

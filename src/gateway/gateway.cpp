@@ -2,6 +2,7 @@
 
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -82,6 +83,24 @@ void check_writable_dir(const std::string& flag, const std::filesystem::path& di
                      "': " + errno_text(errno));
 }
 
+// The flight recorder's folder must be the gateway's alone: another user who can write there can
+// plant files under the next dump's name (symlinks to overwrite something else) or files that
+// retention would count. Refused at start: owned by the gateway's user, no group or other write
+// bit (docs/security.md; docs/service.md's StateDirectory= makes such a folder).
+void check_own_dir(const std::string& flag, const std::string& dir) {
+  struct ::stat info {};
+  if (::stat(dir.c_str(), &info) != 0) return;  // check_writable_dir said why
+  const bool others_write = (info.st_mode & (S_IWGRP | S_IWOTH)) != 0;
+  if (info.st_uid != ::geteuid() || others_write)
+    throw InputError(fmt::format(
+        "--{}: '{}' (owner uid {}, mode {:04o}) {}: other users could plant files or symlinks where the "
+        "flight "
+        "recorder writes and deletes; give it a folder of its own (owned by uid {}, e.g. chmod go-w, or "
+        "StateDirectory= under systemd)",
+        flag, dir, info.st_uid, info.st_mode & 07777,
+        others_write ? "is writable by others than its owner" : "belongs to another user", ::geteuid()));
+}
+
 void check_output_files(const GatewayConfig& config, PrepareFor purpose) {
   if (!config.stats_file.empty()) {
     const std::filesystem::path file = config.stats_file;
@@ -90,8 +109,10 @@ void check_output_files(const GatewayConfig& config, PrepareFor purpose) {
       throw InputError("--stats-file: '" + config.stats_file + "' is a directory: " + errno_text(EISDIR));
     check_writable_dir("stats-file", file.parent_path(), config.stats_file, purpose);
   }
-  if (config.pcap_ring > 0)
+  if (config.pcap_ring > 0) {
     check_writable_dir("pcap-dir", config.pcap_dir, config.pcap_dir + "/*.pcap", purpose);
+    check_own_dir("pcap-dir", config.pcap_dir);
+  }
 }
 
 // The --profiles files or directories, for messages: "a.xml, b/" (or rsg's directory).
@@ -383,7 +404,11 @@ void Gateway::check_other_writers() {
 
 void Gateway::on_link_change() {
   const status::GatewayStats stats = snapshot();
-  spdlog::info("link {} ({})", stats.link_up ? "up" : "down", stats.source);
+  // A forged frame every few ms flaps the link: the first change each way at once, then a count a
+  // minute (on_status_period logs what is held).
+  if (const auto n = (stats.link_up ? link_up_log_ : link_down_log_).take(Clock::now()))
+    spdlog::info("link {} ({}){}", stats.link_up ? "up" : "down", stats.source,
+                 n > 1 ? fmt::format("; {} times since the last such line", n) : std::string());
   status_.publish(stats);  // now, not at the next period: readers act on link changes
   link_last_change_s_ = unix_now_s();
   if (metrics_) metrics_->publish(metrics_snapshot(stats, Clock::now()));
@@ -392,7 +417,12 @@ void Gateway::on_link_change() {
 
 void Gateway::dump_flight_recorder(std::string_view reason) {
   if (!ingress_ || !ingress_->has_flight_recorder()) {
-    if (reason == "signal") spdlog::warn("SIGUSR1: no flight recorder to dump (start with --pcap-ring)");
+    if (reason == "signal")
+      if (const auto n = no_recorder_log_.take(Clock::now()))
+        spdlog::warn(
+            "SIGUSR1: no flight recorder to dump (start with --pcap-ring); {} such signals since the "
+            "last line",
+            n);
     return;
   }
   // The copy here, the file on the dump writer's thread: this is the ingress thread.
@@ -402,14 +432,14 @@ void Gateway::dump_flight_recorder(std::string_view reason) {
     case DumpWriter::Posted::kQueued:
       break;
     case DumpWriter::Posted::kThrottled:  // counted; a flapping link or a signal flood logs once a minute
-      if (dump_throttled_log_.allow(now))
+      if (dump_throttled_log_.take(now) > 0)
         spdlog::warn(
             "flight recorder ({}): not dumped, less than --pcap-min-interval {} s after the last dump "
             "({} such requests since start)",
             reason, config_.pcap_min_interval, dump_writer_->throttled());
       break;
     case DumpWriter::Posted::kRefused:
-      if (dump_refused_log_.allow(now))
+      if (dump_refused_log_.take(now) > 0)
         spdlog::error(
             "flight recorder ({}): not dumped, {} earlier dumps are still being written ({} refused "
             "since start)",
@@ -433,24 +463,76 @@ std::optional<PendingReload::Read> PendingReload::take() {
 void Gateway::take_reload(PendingReload& pending) {
   std::optional<PendingReload::Read> read = pending.take();
   if (!read) return;
+  // A SIGHUP storm re-reads the same file a thousand times: each outcome's first line at once,
+  // then a count a minute (reload_log_line).
+  const auto now = Clock::now();
   try {
     if (const auto* why = std::get_if<std::string>(&*read)) throw InputError(*why);
-    reload(std::get<GatewayConfig>(*read));
-    ++reloads_.applied;
+    if (reload(std::get<GatewayConfig>(*read)) == Reloaded::kApplied)
+      ++reloads_.applied;
+    else
+      ++reloads_.refused;
   } catch (const InputError& error) {
     ++reloads_.failed;
-    spdlog::error("SIGHUP: configuration not reloaded, the running one stays: {}", error.what());
+    if (const auto n = reload_failed_log_.take(now))
+      spdlog::error("SIGHUP: configuration not reloaded, the running one stays: {}{}", error.what(),
+                    n > 1 ? fmt::format(" ({} failed reloads since the last such line)", n) : std::string());
   }
   if (metrics_) metrics_->publish(metrics_snapshot(snapshot(), Clock::now()));
 }
 
-void Gateway::reload(const GatewayConfig& fresh) {
+namespace {
+
+// 0.0.0.0/0 (IPv4-mapped: ::ffff:0:0/96) or ::/0.
+bool is_everyone(const Network& network) {
+  if (network.prefix_bits == 0) return true;
+  static constexpr std::array<std::uint8_t, 12> kMapped{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xff, 0xff};
+  return network.prefix_bits <= 96 && std::equal(kMapped.begin(), kMapped.end(), network.address.begin());
+}
+
+}  // namespace
+
+std::optional<std::string> widened_access(const GatewayConfig& running, const GatewayConfig& fresh) {
+  if (!running.allow_from.empty()) {
+    if (fresh.allow_from.empty())
+      return fmt::format("allow-from would go from [{}] to everyone (no allow-from in the file)",
+                         fmt::join(running.allow_from, ", "));
+    for (const auto& text : fresh.allow_from)
+      if (const wire::Parsed<Network> network = parse_network(text); network && is_everyone(*network))
+        return fmt::format("allow-from would go from [{}] to everyone ({})",
+                           fmt::join(running.allow_from, ", "), text);
+  }
+  if (fresh.participant_profile != running.participant_profile)
+    return fmt::format("participant-profile would change from '{}' to '{}' (DDS Security lives there)",
+                       running.participant_profile, fresh.participant_profile);
+  if (fresh.profiles != running.profiles)
+    return fmt::format("profiles would change from [{}] to [{}] (DDS Security lives there)",
+                       fmt::join(running.profiles, ", "), fmt::join(fresh.profiles, ", "));
+  if (running.data_sharing == "off" && fresh.data_sharing != "off")
+    return fmt::format("data-sharing would go from off to {} (same-host processes, docs/security.md)",
+                       fresh.data_sharing);
+  return std::nullopt;
+}
+
+Gateway::Reloaded Gateway::reload(const GatewayConfig& fresh) {
   if (auto problem = check_config(fresh)) throw InputError(*problem);
   SourceFilter sources;
   for (const auto& network : fresh.allow_from) {
     const wire::Parsed<Network> parsed = parse_network(network);
     if (!parsed) throw InputError("--allow-from: " + parsed.error());
     sources.allow(*parsed);
+  }
+  const auto now = Clock::now();
+  // Refused before anything changes: a file without its allow-from line (deleted by mistake, or
+  // caught half-written) would otherwise let every outsider's frames be published.
+  const std::optional<std::string> widened = widened_access(config_, fresh);
+  if (widened && !fresh.reload_widens_access) {
+    if (const auto n = reload_refused_log_.take(now))
+      spdlog::warn(
+          "SIGHUP: configuration not reloaded, the running one stays: {}; set reload-widens-access: true in "
+          "the file to allow it{}",
+          *widened, n > 1 ? fmt::format(" ({} refused reloads since the last such line)", n) : std::string());
+    return Reloaded::kRefused;
   }
   // Every key that differs: the two a running gateway can take, and the rest, named.
   std::vector<std::string> applied, need_restart;
@@ -463,28 +545,74 @@ void Gateway::reload(const GatewayConfig& fresh) {
                                     fmt::join(config_.allow_from, ", ")));
     else if (key.name == "log-level")
       applied.push_back(fmt::format("log-level {} (was {})", fresh.log_level, config_.log_level));
-    else
+    else if (key.name != "reload-widens-access")  // read at each reload: nothing to restart for
       need_restart.push_back("--" + std::string(key.name));
   }
   if (ingress_) ingress_->set_sources(std::move(sources));
   config_.allow_from = fresh.allow_from;
-  spdlog::info("SIGHUP: configuration reloaded: {}", applied.empty()
-                                                         ? std::string("allow-from and log-level unchanged")
-                                                         : fmt::format("{}", fmt::join(applied, ", ")));
-  if (!need_restart.empty())
-    spdlog::warn("SIGHUP: not applied until a restart: {} (a reload applies allow-from and log-level)",
-                 fmt::join(need_restart, ", "));
+  config_.reload_widens_access = fresh.reload_widens_access;
+  if (const auto n = reload_applied_log_.take(now)) {
+    const std::string since =
+        n > 1 ? fmt::format(" ({} reloads applied since the last such line)", n) : std::string();
+    // Widening on purpose is logged at warning: it is what an operator checks after an incident.
+    const auto level = widened ? spdlog::level::warn : spdlog::level::info;
+    spdlog::log(level, "SIGHUP: configuration reloaded: {}{}",
+                applied.empty() ? std::string("allow-from and log-level unchanged")
+                                : fmt::format("{}", fmt::join(applied, ", ")),
+                since);
+    if (!need_restart.empty())
+      spdlog::warn("SIGHUP: not applied until a restart: {} (a reload applies allow-from and log-level)",
+                   fmt::join(need_restart, ", "));
+  }
   // Last, so that lowering the level does not hide the lines above.
   config_.log_level = fresh.log_level;
   spdlog::set_level(spdlog::level::from_str(log_level_name(fresh)));  // checked: any case
+  return Reloaded::kApplied;
+}
+
+void Gateway::log_held_events(Clock::time_point now) {
+  const auto held = [now](app::RepeatedLog& log, auto&& line) {
+    if (const auto n = log.take(now, 0)) line(n);
+  };
+  held(link_up_log_,
+       [](std::uint64_t n) { spdlog::info("link up {} more times since the last such line", n); });
+  held(link_down_log_,
+       [](std::uint64_t n) { spdlog::info("link down {} more times since the last such line", n); });
+  held(reload_applied_log_,
+       [](std::uint64_t n) { spdlog::info("SIGHUP: {} more reloads applied since the last such line", n); });
+  held(reload_refused_log_, [](std::uint64_t n) {
+    spdlog::warn("SIGHUP: {} more reloads refused since the last such line (they would widen access)", n);
+  });
+  held(reload_failed_log_, [](std::uint64_t n) {
+    spdlog::error("SIGHUP: {} more reloads failed since the last such line (the file did not read or check)",
+                  n);
+  });
+  held(no_recorder_log_, [](std::uint64_t n) {
+    spdlog::warn("SIGUSR1: {} more signals since the last line, no flight recorder to dump", n);
+  });
+  if (dump_writer_) {
+    held(dump_throttled_log_, [&](std::uint64_t n) {
+      spdlog::warn(
+          "flight recorder: {} more requests not dumped since the last line, less than "
+          "--pcap-min-interval {} s after the last dump ({} since start)",
+          n, config_.pcap_min_interval, dump_writer_->throttled());
+    });
+    held(dump_refused_log_, [&](std::uint64_t n) {
+      spdlog::error(
+          "flight recorder: {} more requests not dumped since the last line, earlier dumps still "
+          "being written ({} since start)",
+          n, dump_writer_->refused());
+    });
+  }
 }
 
 status::GatewayStats Gateway::on_status_period(Clock::time_point now) {
   if (ingress_) {
     rate_hz_ = rate_.update(ingress_->valid_frames(), now);
-    ingress_->log_rejections();
+    ingress_->log_rejections(now);
     check_other_writers();
   }
+  log_held_events(now);
   const status::GatewayStats stats = snapshot();
   if (ingress_) ingress_->end_status_period();
   status_.publish(stats);
@@ -516,7 +644,8 @@ MetricsSnapshot Gateway::metrics_snapshot(const status::GatewayStats& stats, Clo
   if (dump_writer_)
     metrics.dumps =
         DumpCounts{dump_writer_->written(),   dump_writer_->failed(),  dump_writer_->refused(),
-                   dump_writer_->throttled(), dump_writer_->deleted(), ingress_->flight_recorder_not_kept()};
+                   dump_writer_->throttled(), dump_writer_->deleted(), ingress_->flight_recorder_not_kept(),
+                   dump_writer_->no_room()};
   metrics.reloads = reloads_;
   const dds::RtpsGuardCounts& guard = participant_.rtps_guard();
   metrics.dds_guard = DdsGuardCounts{guard.statistics_removed.load(std::memory_order_relaxed),

@@ -12,6 +12,7 @@
 #include <string>
 #include <variant>
 
+#include "app/repeated_log.hpp"
 #include "gateway/config.hpp"
 #include "gateway/dump_writer.hpp"
 #include "gateway/egress.hpp"
@@ -79,10 +80,15 @@ class Gateway {
   void run(const std::atomic<bool>& stop, std::atomic<bool>* dump = nullptr, LoopObserver* observer = nullptr,
            PendingReload* reload = nullptr);
 
+  /// What became of a reload.
+  enum class Reloaded { kApplied, kRefused };
+
   /// Applies what of `fresh` can change while running -- allow-from and log-level -- and logs it,
-  /// and names every other key that differs as needing a restart.
+  /// and names every other key that differs as needing a restart. A configuration that widens
+  /// access (widened_access()) is refused unless it sets reload-widens-access: nothing changes
+  /// then, and the refusal is logged at warning.
   /// @throws rsg::InputError when `fresh` does not pass check_config; nothing changes then.
-  void reload(const GatewayConfig& fresh);
+  Reloaded reload(const GatewayConfig& fresh);
 
   /// Where ingress receives frames; nothing when there is no ingress.
   std::optional<transport::Endpoint> ingress_endpoint() const {
@@ -94,6 +100,7 @@ class Gateway {
   void check_other_writers();
   void dump_flight_recorder(std::string_view reason);
   void take_reload(PendingReload& reload);
+  void log_held_events(Clock::time_point now);                   // the counts app::RepeatedLog held back
   status::GatewayStats on_status_period(Clock::time_point now);  // returns the stats it reported
   status::GatewayStats snapshot() const;
   MetricsSnapshot metrics_snapshot(const status::GatewayStats& stats, Clock::time_point now) const;
@@ -110,8 +117,10 @@ class Gateway {
   std::optional<NoLinkWarning> no_link_;   // with ingress
   StatsFile stats_file_;                   // --stats-file, written by a thread of its own
   std::optional<DumpWriter> dump_writer_;  // with a flight recorder: writes its dumps
-  LogThrottle dump_throttled_log_{std::chrono::minutes(1)};
-  LogThrottle dump_refused_log_{std::chrono::minutes(1)};
+  // Per-event lines an outsider can repeat (a flapping link, a signal storm): app::RepeatedLog.
+  app::RepeatedLog dump_throttled_log_, dump_refused_log_, no_recorder_log_;
+  app::RepeatedLog link_up_log_, link_down_log_;
+  app::RepeatedLog reload_applied_log_, reload_refused_log_, reload_failed_log_;
   ReloadCounts reloads_;
   std::string own_participant_;            // participant_'s GUID prefix, dds::participant_key
   std::string state_topic_;                // ingress's DDS topic; "" without ingress
@@ -120,6 +129,11 @@ class Gateway {
   std::string gateway_label_;              // the metrics' `gateway` label
   std::optional<MetricsServer> metrics_;   // last: serves snapshots of everything above
 };
+
+/// Why a reload from `running` to `fresh` would widen who can reach the gateway, or nothing: an
+/// allow-from that disappears or grows to everyone (0.0.0.0/0, ::/0), a participant profile or
+/// profile list that changes (DDS Security lives there), data-sharing from off to auto.
+std::optional<std::string> widened_access(const GatewayConfig& running, const GatewayConfig& fresh);
 
 /// Puts the calling thread (the one that will call `Gateway::run`) in the configured real-time
 /// mode, logging what was refused. Call it once the Gateway exists: Fast DDS has created its

@@ -270,8 +270,9 @@ void Ingress::request_selection(const transport::Endpoint& robot) {
   // most once a second), so it may log.
   if (encoded && socket_.send_to(std::span(request).first(encoded.size), robot))
     requester_->log_sent(robot.to_string(), source_.size() ? source_.to_string() : std::string());
-  else
-    spdlog::warn("could not send the selection request to {}", robot.to_string());
+  else if (const auto n = request_failed_log_.take(Clock::now()))
+    spdlog::warn("could not send the selection request to {} ({} times since the last such line)",
+                 robot.to_string(), n);
 }
 
 void Ingress::set_sources(SourceFilter sources) { options_.sources = std::move(sources); }
@@ -311,29 +312,37 @@ void Ingress::fill(status::GatewayStats& stats) const {
   stats.ingress_delay_max_us = micros(delay_max_);
 }
 
-void Ingress::log_rejections() {
-  const std::uint64_t rejected_source = counters_.rejected_source - logged_rejected_source_;
-  if (rejected_source)
-    spdlog::warn("ignored {} datagrams from outside --allow-from, the last from {}", rejected_source,
-                 last_foreign_sender_.to_string());
-  logged_rejected_source_ = counters_.rejected_source;
-
-  status::InvalidCounts fresh{};
-  bool any = false;
-  for (std::size_t i = 0; i < fresh.size(); ++i) {
-    fresh[i] = counters_.invalid[i] - logged_invalid_[i];
-    any |= fresh[i] != 0;
+void Ingress::log_rejections(Clock::time_point now) {
+  // Each kind: the counts since its last line, once its RepeatedLog says a line is due.
+  if (rejected_source_log_.take(now, counters_.rejected_source - counted_rejected_source_) > 0) {
+    spdlog::warn("ignored {} datagrams from outside --allow-from since the last line, the last from {}",
+                 counters_.rejected_source - logged_rejected_source_, last_foreign_sender_.to_string());
+    logged_rejected_source_ = counters_.rejected_source;
   }
-  if (any)
-    spdlog::warn("rejected invalid frames: {}; the last from {}: {}: {}", status::format_invalid(fresh),
-                 last_rejected_sender_.to_string(), wire::to_string(last_rejection_.category()),
-                 last_rejection_.message());
-  logged_invalid_ = counters_.invalid;
+  counted_rejected_source_ = counters_.rejected_source;
 
-  if (standard_topics_ && standard_topics_->dropped() > logged_standard_dropped_) {
-    spdlog::warn("ROS 2 standard topics: {} snapshots dropped, their publishing thread is behind",
-                 standard_topics_->dropped() - logged_standard_dropped_);
-    logged_standard_dropped_ = standard_topics_->dropped();
+  std::uint64_t invalid = 0;
+  for (const std::uint64_t count : counters_.invalid) invalid += count;
+  if (invalid_log_.take(now, invalid - counted_invalid_) > 0) {
+    status::InvalidCounts fresh{};
+    for (std::size_t i = 0; i < fresh.size(); ++i) fresh[i] = counters_.invalid[i] - logged_invalid_[i];
+    spdlog::warn("rejected invalid frames since the last line: {}; the last from {}: {}: {}",
+                 status::format_invalid(fresh), last_rejected_sender_.to_string(),
+                 wire::to_string(last_rejection_.category()), last_rejection_.message());
+    logged_invalid_ = counters_.invalid;
+  }
+  counted_invalid_ = invalid;
+
+  if (standard_topics_) {
+    const std::uint64_t dropped = standard_topics_->dropped();
+    if (standard_dropped_log_.take(now, dropped - counted_standard_dropped_) > 0) {
+      spdlog::warn(
+          "ROS 2 standard topics: {} snapshots dropped since the last line, their publishing thread "
+          "is behind",
+          dropped - logged_standard_dropped_);
+      logged_standard_dropped_ = dropped;
+    }
+    counted_standard_dropped_ = dropped;
   }
 }
 

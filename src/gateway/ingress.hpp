@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "app/repeated_log.hpp"
 #include "gateway/clock.hpp"
 #include "gateway/data_sharing.hpp"
 #include "gateway/decimator.hpp"
@@ -102,8 +103,9 @@ class Ingress {
   /// host's, so only what a frame took longer than the quickest one recently can be told.
   const LatencyHistogram& age_histogram() const { return age_histogram_; }
 
-  /// Logs one line when frames were rejected since the last call (the caller calls it once a second).
-  void log_rejections();
+  /// Logs what was rejected since the last line (the caller calls it once a second): the first
+  /// time at once, then at most one line a minute per kind (app::RepeatedLog), with the counts.
+  void log_rejections(Clock::time_point now);
 
   transport::Endpoint local_endpoint() const { return socket_.local_endpoint(); }
 
@@ -184,6 +186,10 @@ class Ingress {
   std::uint64_t logged_rejected_source_ = 0;
   std::uint64_t logged_standard_dropped_ = 0;
   transport::Endpoint last_foreign_sender_;
+  // Counted once a second, logged once a minute: a misconfigured robot or a flood from outside
+  // allow-from would otherwise write a line a second (86,400 a day).
+  std::uint64_t counted_rejected_source_ = 0, counted_invalid_ = 0, counted_standard_dropped_ = 0;
+  app::RepeatedLog rejected_source_log_, invalid_log_, standard_dropped_log_, request_failed_log_;
 };
 
 }  // namespace rsg::gateway

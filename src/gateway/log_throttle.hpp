@@ -1,5 +1,5 @@
-// Rate limit for log lines about per-frame events: the hot path counts, and a summary is logged
-// at most once per interval, so a flood of bad frames cannot turn into a flood of log lines.
+// The pacing of the gateway's summary line. Lines about events an outsider can repeat go through
+// app::RepeatedLog (src/app/repeated_log.hpp) instead: the first at once, then a count a minute.
 #pragma once
 
 #include <string>
@@ -7,24 +7,6 @@
 #include "gateway/clock.hpp"
 
 namespace rsg::gateway {
-
-class LogThrottle {
- public:
-  explicit LogThrottle(Clock::duration interval) : interval_(interval) {}
-
-  /// True (and the interval restarts) when a line may be logged at `now`.
-  bool allow(Clock::time_point now) {
-    if (logged_once_ && now - last_ < interval_) return false;
-    logged_once_ = true;
-    last_ = now;
-    return true;
-  }
-
- private:
-  Clock::duration interval_;
-  Clock::time_point last_{};
-  bool logged_once_ = false;
-};
 
 /// When the gateway logs its summary line: at most every `busy` while the line changes (frames
 /// flow, counters move), and every `idle` while it does not, so that an idle gateway's log stays

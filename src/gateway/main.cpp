@@ -8,16 +8,17 @@
 // configuration (flags, file, profiles, addresses) is unusable, 1 when the machine refuses (the port
 // is taken, DDS refuses an entity); nothing is left running then. A refused real-time setting
 // (--rt-priority, --cpu) is a warning, not a failure.
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "app/stop_on_signal.hpp"
@@ -87,22 +88,54 @@ void add_config_flags(CLI::App& app, GatewayConfig& config, Command& command) {
   }
 }
 
-std::string read_file(const std::string& path) {
-  std::error_code error;
-  // An ifstream opens a directory and reads nothing from it: it would be an empty configuration.
-  if (std::filesystem::is_directory(path, error))
-    throw rsg::InputError("--config: '" + path + "' is a directory: " + rsg::gateway::errno_text(EISDIR));
-  std::ifstream in(path);
-  if (!in) throw rsg::InputError("--config: cannot read " + path + ": " + rsg::gateway::errno_text(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+// The file, read once through one descriptor. A file that changes while it is read (its size or
+// time moves) is refused rather than parsed half: docs/configuration.md says how to replace it
+// atomically (write a copy, rename it over). On a reload, a file that does not end with a newline
+// is refused too: a file cut while written ends mid-line, an editor's always ends with one.
+std::string read_file(const std::string& path, bool reloading) {
+  using rsg::gateway::errno_text;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw rsg::InputError("--config: cannot read " + path + ": " + errno_text(errno));
+  struct Close {
+    int fd;
+    ~Close() { ::close(fd); }
+  } const closing{fd};
+  struct ::stat before {};
+  if (::fstat(fd, &before) != 0)
+    throw rsg::InputError("--config: cannot read " + path + ": " + errno_text(errno));
+  // A directory opens and reads as nothing: it would be an empty configuration.
+  if (S_ISDIR(before.st_mode))
+    throw rsg::InputError("--config: '" + path + "' is a directory: " + errno_text(EISDIR));
+  std::string text;
+  std::array<char, 8192> chunk{};
+  for (;;) {
+    const ::ssize_t got = ::read(fd, chunk.data(), chunk.size());
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) throw rsg::InputError("--config: cannot read " + path + ": " + errno_text(errno));
+    if (got == 0) break;
+    text.append(chunk.data(), static_cast<std::size_t>(got));
+  }
+  struct ::stat after {};
+  const bool changed = ::fstat(fd, &after) != 0 || after.st_size != before.st_size ||
+                       after.st_mtim.tv_sec != before.st_mtim.tv_sec ||
+                       after.st_mtim.tv_nsec != before.st_mtim.tv_nsec ||
+                       static_cast<::off_t>(text.size()) != after.st_size;
+  if (changed)
+    throw rsg::InputError("--config: " + path +
+                          " changed while it was read: not used (replace it atomically: write a copy next "
+                          "to it, then rename the copy over it)");
+  if (reloading && !text.empty() && text.back() != '\n')
+    throw rsg::InputError("--config: " + path +
+                          " does not end with a newline: is it still being written? Not used (replace it "
+                          "atomically: write a copy next to it, then rename the copy over it)");
+  return text;
 }
 
 // The configuration: the instance's defaults (--instance), the file (--config) over them, the
 // flags over both.
 // @throws rsg::InputError when the file cannot be read or does not parse, or the instance is no name.
-GatewayConfig read_config(const Command& command, const GatewayConfig& flags_only, int argc, char** argv) {
+GatewayConfig read_config(const Command& command, const GatewayConfig& flags_only, int argc, char** argv,
+                          bool reloading = false) {
   if (command.config_file.empty() && command.instance.empty()) return flags_only;
   GatewayConfig config;
   if (!command.instance.empty()) {
@@ -111,7 +144,8 @@ GatewayConfig read_config(const Command& command, const GatewayConfig& flags_onl
     config = std::get<GatewayConfig>(std::move(defaults));
   }
   if (const std::string& file = command.config_file; !file.empty()) {
-    const rsg::gateway::ConfigResult parsed = rsg::gateway::parse_gateway_config(read_file(file), config);
+    const rsg::gateway::ConfigResult parsed =
+        rsg::gateway::parse_gateway_config(read_file(file, reloading), config);
     if (!parsed) {
       const auto& error = parsed.error();
       throw rsg::InputError(file + (error.line > 0 ? ":" + std::to_string(error.line) : std::string()) +
@@ -168,7 +202,7 @@ int main(int argc, char** argv) {
     rsg::gateway::PendingReload reload;
     const auto reread = [&] {
       try {
-        reload.offer(read_config(command, flags_only, argc, argv));
+        reload.offer(read_config(command, flags_only, argc, argv, /*reloading=*/true));
       } catch (const std::exception& error) {  // a bad file must not end a running gateway
         reload.offer(std::string(error.what()));
       }

@@ -63,8 +63,9 @@ constexpr Family kEgressRateLimited{"rsg_egress_rate_limited_total", Type::kCoun
 constexpr Family kDumps{
     "rsg_flight_recorder_dumps_total", Type::kCounter,
     "Flight-recorder dumps by result: written, failed (the file could not be written), "
-    "refused (earlier dumps were still being written) or throttled (asked for sooner than "
-    "--pcap-min-interval after the last one)"};
+    "refused (earlier dumps were still being written), throttled (asked for sooner than "
+    "--pcap-min-interval after the last one) or no_room (pcap-dir is full of files retention "
+    "protects: younger than an hour, the newest, the last before a quiet hour)"};
 constexpr Family kDumpFilesDeleted{
     "rsg_flight_recorder_files_deleted_total", Type::kCounter,
     "Flight-recorder files deleted, oldest first, to stay within --pcap-max-files "
@@ -73,8 +74,9 @@ constexpr Family kDumpNotKept{"rsg_flight_recorder_datagrams_not_kept_total", Ty
                               "Datagrams from outside --allow-from the flight recorder left out of its ring "
                               "(--pcap-all-sources keeps them)"};
 constexpr Family kReloads{"rsg_config_reloads_total", Type::kCounter,
-                          "Configuration reloads on SIGHUP by result: applied, or failed (the running "
-                          "configuration stayed)"};
+                          "Configuration reloads on SIGHUP by result: applied, failed (the file did not "
+                          "read or check) or refused (it would widen access without reload-widens-access); "
+                          "the running configuration stays unless applied"};
 constexpr Family kDdsGuard{
     "rsg_dds_guard_total", Type::kCounter,
     "What the DDS transport guard did: statistics_removed (the statistics submessage "
@@ -320,6 +322,7 @@ std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<
     out.sample(kDumps, dumps->failed, "result=\"failed\"");
     out.sample(kDumps, dumps->refused, "result=\"refused\"");
     out.sample(kDumps, dumps->throttled, "result=\"throttled\"");
+    out.sample(kDumps, dumps->no_room, "result=\"no_room\"");
     out.one(kDumpFilesDeleted, dumps->files_deleted);
     out.one(kDumpNotKept, dumps->not_kept);
   }
@@ -338,6 +341,7 @@ std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<
   out.family(kReloads);
   out.sample(kReloads, snapshot.reloads.applied, "result=\"applied\"");
   out.sample(kReloads, snapshot.reloads.failed, "result=\"failed\"");
+  out.sample(kReloads, snapshot.reloads.refused, "result=\"refused\"");
 
   out.one(kLinkUp, stats.link_up ? 1 : 0);
   out.one(kLinkChange, snapshot.link_last_change_s);

@@ -27,12 +27,14 @@ struct DumpCounts {
   std::uint64_t throttled = 0;      ///< not taken: sooner than --pcap-min-interval after the last
   std::uint64_t files_deleted = 0;  ///< oldest files deleted for --pcap-max-files / --pcap-max-mb
   std::uint64_t not_kept = 0;       ///< datagrams from outside --allow-from left out of the ring
+  std::uint64_t no_room = 0;        ///< not written: every file in pcap-dir is protected (DumpWriter)
 };
 
 /// SIGHUP's reloads of the configuration since start (Gateway::reload).
 struct ReloadCounts {
   std::uint64_t applied = 0;
-  std::uint64_t failed = 0;  ///< the file did not read or check: the running configuration stayed
+  std::uint64_t failed = 0;   ///< the file did not read or check: the running configuration stayed
+  std::uint64_t refused = 0;  ///< it would widen access without reload-widens-access: it stayed too
 };
 
 /// What the transport guard of the gateway's participant did (rsg/dds/rtps_guard.hpp).

@@ -16,8 +16,8 @@
 #include <thread>
 
 #include "app/http_reply.hpp"
+#include "app/repeated_log.hpp"
 #include "app/tcp_listener.hpp"
-#include "gateway/log_throttle.hpp"
 #include "rsg/error.hpp"
 
 namespace rsg::gateway {
@@ -37,7 +37,6 @@ using SnapshotPointer = std::shared_ptr<const MetricsSnapshot>;
 enum class Closed : std::size_t { kPerClientLimit, kTotalLimit, kHeaderTimeout, kIdleTimeout, kCount };
 constexpr std::array<std::string_view, static_cast<std::size_t>(Closed::kCount)> kClosedReasons = {
     "per_client_limit", "total_limit", "header_timeout", "idle_timeout"};
-constexpr auto kLimitLogInterval = std::chrono::minutes(1);
 
 /// What the I/O thread's connections share. I/O thread only, but for the options and snapshot.
 struct Shared {
@@ -48,15 +47,13 @@ struct Shared {
   std::atomic<SnapshotPointer> snapshot;
   app::ConnectionTable table;
   std::array<std::uint64_t, kClosedReasons.size()> closed{};
-  std::array<LogThrottle, kClosedReasons.size()> throttles{
-      LogThrottle(kLimitLogInterval), LogThrottle(kLimitLogInterval), LogThrottle(kLimitLogInterval),
-      LogThrottle(kLimitLogInterval)};
+  std::array<app::RepeatedLog, kClosedReasons.size()> logs{};
 
-  /// Counts a connection the server closed, and says so at most once a minute.
+  /// Counts a connection the server closed, and says so the first time, then at most once a minute.
   void count(Closed reason) {
     const auto i = static_cast<std::size_t>(reason);
     ++closed[i];
-    if (throttles[i].allow(Clock::now()))
+    if (logs[i].take(Clock::now()) > 0)
       spdlog::warn(
           "metrics: {} connection(s) closed so far by {} (limits: {} connections, {} per client, header in "
           "{} "

@@ -370,6 +370,26 @@ TEST(GatewayConfig, FlightRecorderNeedsADirectoryAndAListeningSocket) {
   EXPECT_NE(check_config(broken)->find("--pcap-ring needs --listen"), std::string::npos);
 }
 
+// Issue 51: a check that reads another key saw only the lines above it, so the same keys were
+// refused in one order and accepted in the other. Checks run once the whole file is read.
+TEST(GatewayConfig, ACrossKeyCheckDoesNotDependOnTheOrderOfTheLines) {
+  for (const std::string_view yaml :
+       {"pcap-ring: 600\nexpected-rate: 200\n", "expected-rate: 200\npcap-ring: 600\n"}) {
+    const GatewayConfig config = parse_ok(yaml);
+    EXPECT_EQ(config.pcap_ring, 600) << yaml;
+    EXPECT_EQ(config.expected_rate, 200) << yaml;
+  }
+  // Too large in both orders, named on the line of the key whose check fails.
+  for (const auto& [yaml, line] :
+       {std::pair<std::string_view, int>{"pcap-ring: 600\nexpected-rate: 201\n", 1},
+        {"expected-rate: 201\npcap-ring: 600\n", 2}}) {
+    const ConfigError error = parse_error(yaml);
+    EXPECT_EQ(error.line, line) << yaml;
+    EXPECT_NE(error.message.find("pcap-ring: 600 s at --expected-rate 201"), std::string::npos)
+        << error.message;
+  }
+}
+
 TEST(GatewayConfig, FlightRecorderIsBoundedByDefaultAndItsBoundsAreChecked) {
   const GatewayConfig defaults;
   EXPECT_EQ(defaults.pcap_min_interval, 10);

@@ -2,7 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include "gateway/log_throttle.hpp"
 #include "gateway/selection_requester.hpp"
 
 namespace rsg::gateway {
@@ -60,14 +59,6 @@ TEST(RateMeter, FramesPerSecondBetweenReadings) {
   EXPECT_EQ(meter.update(0, kStart), 0.0);
   EXPECT_DOUBLE_EQ(meter.update(500, kStart + milliseconds(500)), 1000.0);
   EXPECT_DOUBLE_EQ(meter.update(500, kStart + milliseconds(1500)), 0.0);
-}
-
-TEST(LogThrottle, AllowsOneLinePerInterval) {
-  LogThrottle throttle(std::chrono::seconds(1));
-  EXPECT_TRUE(throttle.allow(kStart));
-  EXPECT_FALSE(throttle.allow(kStart + milliseconds(999)));
-  EXPECT_TRUE(throttle.allow(kStart + milliseconds(1000)));
-  EXPECT_FALSE(throttle.allow(kStart + milliseconds(1500)));
 }
 
 wire::Selection groups(std::initializer_list<std::size_t> list) {

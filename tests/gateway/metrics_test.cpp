@@ -33,8 +33,8 @@ MetricsSnapshot example() {
   stats.rate_hz = 999.5;
   stats.ingress_delay_us = 250;
   stats.ingress_delay_max_us = 1500;
-  snapshot.dumps = DumpCounts{4, 1, 2, 7, 3, 9};
-  snapshot.reloads = ReloadCounts{5, 1};
+  snapshot.dumps = DumpCounts{4, 1, 2, 7, 3, 9, 6};
+  snapshot.reloads = ReloadCounts{5, 1, 8};
   for (const auto us : {30, 250, 250, 4000}) snapshot.ingress_delay.record(std::chrono::microseconds(us));
   snapshot.frame_age.record(std::chrono::seconds(2));  // above every bound: +Inf only
   return snapshot;
@@ -86,6 +86,8 @@ TEST(Metrics, FlightRecorderDumpsHaveOneSeriesPerResult) {
   EXPECT_EQ(values.at(series("rsg_flight_recorder_datagrams_not_kept_total")), "9");
   EXPECT_EQ(values.at(series("rsg_config_reloads_total", R"(result="applied")")), "5");
   EXPECT_EQ(values.at(series("rsg_config_reloads_total", R"(result="failed")")), "1");
+  EXPECT_EQ(values.at(series("rsg_config_reloads_total", R"(result="refused")")), "8");
+  EXPECT_EQ(values.at(series("rsg_flight_recorder_dumps_total", R"(result="no_room")")), "6");
   MetricsSnapshot without = example();
   without.dumps.reset();
   EXPECT_EQ(format_metrics(without, std::nullopt).find("rsg_flight_recorder"), std::string::npos);

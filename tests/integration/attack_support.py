@@ -8,11 +8,35 @@ import struct
 import subprocess
 import threading
 import time
+import zlib
 
 from harness import check, wait_for, wait_for_stats, wait_reader_matched
 from metrics_support import http_get, parse_samples, require_tool
 
 LINKTYPE_RAW = 101  # what the gateway's dumps hold (src/capture/pcap_file.hpp)
+
+
+def valid_frame(number, time_ms, q=0.0):
+    """A valid frame carrying q and time (CRC right), packet number `number` (mod 16): what a robot,
+    or anyone who forges one, sends. q is field 21 (group 2, bit 5), time field 43 (group 5, bit 3):
+    docs/protocol.md."""
+    data = struct.pack("<7d", *([q] * 7)) + struct.pack("<Q", time_ms)
+    selection = bytes([0b100100, 0, 0, 0x20, 0, 0, 0x08])  # group_select, then data_select[0..5]
+    body = bytes([0x30 | (number % 16)]) + struct.pack("<H", len(data)) + selection + data
+    return body + struct.pack("<I", zlib.crc32(body))
+
+
+def send_frames(port, count, rate, source="127.0.0.1", first=0):
+    """`count` frames in step (numbers and times from `first`), `rate` a second, from `source` to the
+    gateway on 127.0.0.1:`port`."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
+        sender.bind((source, 0))
+        start = time.monotonic()
+        for i in range(count):
+            delay = start + i / rate - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+            sender.sendto(valid_frame(first + i, int((first + i) * 1000 / rate)), ("127.0.0.1", port))
 
 
 class JunkFlood(threading.Thread):

@@ -94,7 +94,7 @@ def body(h):
     stuck_dump_writer(h, gateway, stats, port, dumps)
     # Every dump counted by how it ended: all written (the files in the folder), one refused.
     wait_for(lambda: dump_counts(metrics) == {"written": len(list(dumps.glob("*.pcap"))), "failed": 0, "refused": 1,
-                                             "throttled": 0},
+                                             "throttled": 0, "no_room": 0},
              f"rsg_flight_recorder_dumps_total to count the dumps (it says {dump_counts(metrics)})")
     check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
 

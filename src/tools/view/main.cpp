@@ -77,6 +77,11 @@ void add_options(CLI::App& app, Options& options) {
   app.add_option("--max-clients", options.server.max_clients, "WebSocket clients served at once")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
+  app.add_option("--max-clients-per-address", options.server.max_clients_per_address,
+                 "WebSocket clients served at once per client IP address, so that a few addresses cannot "
+                 "hold every place of --max-clients")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
   app.add_option("--max-connections", options.server.max_connections,
                  "TCP connections (HTTP and WebSocket) open at once; at the limit the oldest one that only "
                  "waits (for a request, or a client with no subscription) makes room, else the new one is "

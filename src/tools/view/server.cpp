@@ -22,6 +22,7 @@
 #include <variant>
 
 #include "app/http_reply.hpp"
+#include "app/repeated_log.hpp"
 #include "app/tcp_listener.hpp"
 #include "rsg/error.hpp"
 
@@ -39,10 +40,6 @@ using foxglove::Level;
 constexpr std::size_t kMaxControlBacklog = 1024;
 constexpr std::size_t kMaxRequestHeader = 8 * 1024;
 constexpr auto kTickPeriod = std::chrono::seconds(1);
-// A client without a subscription for this long may make room for a newer connection: a client
-// that just connected has not had the time to subscribe.
-constexpr auto kIdleGrace = std::chrono::seconds(1);
-constexpr auto kLimitLogInterval = std::chrono::minutes(1);
 // A client that queued more than this gives its memory back to the system when it leaves (glibc
 // keeps freed small blocks otherwise, and the process stays that large).
 constexpr std::size_t kTrimAfter = 1 << 20;
@@ -75,7 +72,7 @@ struct Hub {
   std::uint64_t next_session = 1;
   app::ConnectionTable table;
   std::array<std::atomic<std::uint64_t>, Server::kLimitNames.size()> limits{};
-  std::array<SteadyClock::time_point, Server::kLimitNames.size()> limit_logged{};
+  std::array<app::RepeatedLog, Server::kLimitNames.size()> limit_logs{};
   std::atomic<std::uint64_t> dropped{0};
   // Per channel, in the order of `channels`; published is written by publish()'s caller.
   std::unique_ptr<std::atomic<std::uint64_t>[]> channel_published, channel_dropped;
@@ -92,10 +89,13 @@ struct Hub {
   void count(LimitEvent event, std::string_view what, std::uint64_t n = 1) {
     const auto i = static_cast<std::size_t>(event);
     const auto total = limits[i].fetch_add(n, std::memory_order_relaxed) + n;
-    const auto now = SteadyClock::now();
-    if (total != n && now - limit_logged[i] < kLimitLogInterval) return;
-    limit_logged[i] = now;
-    spdlog::warn("limit {}: {} ({} so far)", Server::kLimitNames[i], what, total);
+    if (limit_logs[i].take(SteadyClock::now(), n) > 0)
+      spdlog::warn("limit {}: {} ({} so far)", Server::kLimitNames[i], what, total);
+  }
+
+  /// How long a client has to subscribe before it may make room for another.
+  SteadyClock::duration subscribe_grace() const {
+    return std::min<SteadyClock::duration>(Server::kSubscribeGrace, options.idle_timeout / 2);
   }
 };
 
@@ -106,8 +106,9 @@ class WsSession : public std::enable_shared_from_this<WsSession>, public app::Co
         hub_(hub),
         subprotocol_(subprotocol),
         peer_(endpoint_text(beast::get_lowest_layer(ws_).socket())),
+        address_(address_of(beast::get_lowest_layer(ws_).socket())),
         timer_(ws_.get_executor()) {
-    slot_.join(hub_.table, address_of(beast::get_lowest_layer(ws_).socket()), *this);
+    slot_.join(hub_.table, address_, *this);
   }
   ~WsSession() {
     if (buffered_peak_ > kTrimAfter) ::malloc_trim(0);
@@ -170,9 +171,11 @@ class WsSession : public std::enable_shared_from_this<WsSession>, public app::Co
 
   void evict() override { finish(); }
 
-  /// Without a subscription since at least kIdleGrace: may make room for another client.
+  /// Without a subscription for longer than its grace (Hub::subscribe_grace), whatever it sent:
+  /// may make room for another client.
   bool idle() const { return idle_; }
   std::uint64_t number() const { return number_; }
+  const net::ip::address& address() const { return address_; }
 
  private:
   struct Queued {
@@ -203,29 +206,52 @@ class WsSession : public std::enable_shared_from_this<WsSession>, public app::Co
         hub_.count(LimitEvent::kHandshake, "client " + peer_ + " did not finish its WebSocket handshake");
       return close();
     }
-    if (hub_.sessions.size() >= hub_.options.max_clients) {
-      // The client idle the longest makes room; with none idle this one is refused.
-      std::shared_ptr<WsSession> victim;
-      for (const auto& session : hub_.sessions)
-        if (session->idle() && (!victim || session->number() < victim->number())) victim = session;
-      hub_.count(LimitEvent::kClients, "already " + std::to_string(hub_.sessions.size()) + " clients: " +
-                                           (victim ? "closed the longest idle one" : "refused " + peer_));
-      if (!victim) {
-        slot_.leave();
-        ws_.async_close(websocket::close_reason(websocket::close_code::try_again_later, "too many clients"),
-                        [self = shared_from_this()](beast::error_code) {});
-        return;
-      }
-      victim->finish();
+    if (!admit()) {
+      slot_.leave();
+      ws_.async_close(websocket::close_reason(websocket::close_code::try_again_later, "too many clients"),
+                      [self = shared_from_this()](beast::error_code) {});
+      return;
     }
     hub_.sessions.insert(shared_from_this());
     number_ = hub_.next_session++;
-    last_activity_ = SteadyClock::now();
+    connected_ = unsubscribed_since_ = SteadyClock::now();
     spdlog::info("client {} connected ({})", peer_, subprotocol_);
     send_text(foxglove::server_info("rsg_view", std::to_string(number_)));
     send_text(hub_.advertise);
     read();
     schedule_tick();
+  }
+
+  /// Room for this client: under both caps, or an idle client of the address holding the most
+  /// clients closed to make it, the oldest of them. A client that subscribed, or is within its
+  /// grace, is never closed for another; with none idle this one is refused (false). A client of
+  /// an address at its cap is refused, and an address that holds clients already takes a place of
+  /// another address only from one holding at least two more: an attacker renewing its clients
+  /// would otherwise close its own or another address's idle ones in turn for ever, every renewed
+  /// one within a fresh grace, so that none would ever be idle for a newcomer.
+  bool admit() {
+    std::map<net::ip::address, std::size_t> held;
+    for (const auto& session : hub_.sessions) ++held[session->address()];
+    const std::size_t mine = held[address_];
+    if (mine >= hub_.options.max_clients_per_address) {
+      hub_.count(LimitEvent::kClientsPerAddress, "already " + std::to_string(mine) + " clients from " +
+                                                     address_.to_string() + ": refused " + peer_);
+      return false;
+    }
+    if (hub_.sessions.size() < hub_.options.max_clients) return true;
+    std::shared_ptr<WsSession> victim;
+    for (const auto& session : hub_.sessions) {
+      if (!session->idle() || (mine > 0 && held[session->address()] < mine + 2)) continue;
+      if (!victim || held[session->address()] > held[victim->address()] ||
+          (held[session->address()] == held[victim->address()] && session->number() < victim->number()))
+        victim = session;
+    }
+    hub_.count(LimitEvent::kClients,
+               "already " + std::to_string(hub_.sessions.size()) + " clients: " +
+                   (victim ? "closed an idle one of " + victim->address().to_string() : "refused " + peer_));
+    if (!victim) return false;
+    victim->finish();
+    return true;
   }
 
   void read() {
@@ -242,8 +268,8 @@ class WsSession : public std::enable_shared_from_this<WsSession>, public app::Co
         hub_.count(LimitEvent::kIdle, "client " + peer_ + " answered no ping: closed");
       return finish();
     }
+    // What a client sends never makes it less idle: only a subscription does (schedule_tick).
     const auto now = SteadyClock::now();
-    last_activity_ = now;
     if (now - window_start_ >= std::chrono::seconds(1)) {
       window_start_ = now;
       window_count_ = 0;
@@ -300,6 +326,7 @@ class WsSession : public std::enable_shared_from_this<WsSession>, public app::Co
               if (it == subscriptions_.end()) continue;
               for (const auto& queued : it->second.queue) buffered_ -= queued_size(queued);
               subscriptions_.erase(it);
+              if (subscriptions_.empty()) unsubscribed_since_ = SteadyClock::now();
             }
           } else if constexpr (std::is_same_v<T, foxglove::Unsupported>) {
             send_text(foxglove::status(Level::error, "unsupported operation '" + message.op + "'"));
@@ -371,10 +398,11 @@ class WsSession : public std::enable_shared_from_this<WsSession>, public app::Co
     timer_.async_wait([self = shared_from_this()](beast::error_code ec) {
       if (ec || self->closed_) return;
       const auto now = SteadyClock::now();
-      const auto quiet = now - self->last_activity_;
-      self->idle_ = self->subscriptions_.empty() && quiet >= kIdleGrace;
+      const auto unsubscribed = now - self->unsubscribed_since_;
+      // The grace runs once, from connecting: unsubscribing and subscribing again buys no more.
+      self->idle_ = self->subscriptions_.empty() && now - self->connected_ >= self->hub_.subscribe_grace();
       self->slot_.waiting(self->idle_);
-      if (self->idle_ && quiet >= self->hub_.options.idle_timeout) {
+      if (self->idle_ && unsubscribed >= self->hub_.options.idle_timeout) {
         self->hub_.count(LimitEvent::kIdle, "client " + self->peer_ + " subscribed to nothing: closed");
         return self->finish();
       }
@@ -417,10 +445,13 @@ class WsSession : public std::enable_shared_from_this<WsSession>, public app::Co
   Hub& hub_;
   std::string subprotocol_;
   std::string peer_;
+  net::ip::address address_;
   net::steady_timer timer_;
   app::ConnectionTable::Slot slot_;
   std::uint64_t number_ = 0;
-  SteadyClock::time_point last_activity_ = SteadyClock::now(), write_started_{};
+  // Since when it has had no subscription (connected, or unsubscribed from its last one).
+  SteadyClock::time_point unsubscribed_since_ = SteadyClock::now(), write_started_{};
+  SteadyClock::time_point connected_ = SteadyClock::now();
   bool idle_ = false;
   std::size_t buffered_ = 0, buffered_peak_ = 0;  // bytes queued: payloads, their headers, statuses
   beast::flat_buffer in_;

@@ -331,6 +331,46 @@ def attack_idle_clients(h):
     check(counts["clients"] >= 1 and counts["idle_timeout"] >= 15, f"limits: {counts}")
 
 
+def attack_chatty_clients(h):
+    """Issue 51: 16 WebSocket clients from 2 addresses (127.0.0.2, .3) that subscribe to nothing and
+    send a 40-byte message every 0.5 s, each renewed as rsg_view closes or refuses it, for 30 s. What
+    a client sends never makes it less idle, and an address holds at most --max-clients-per-address
+    (4) clients, so two addresses hold at most 8 of --max-clients (16). Once they are past the grace
+    a new client has to subscribe (Server::kSubscribeGrace, 10 s), 12 legitimate Foxglove clients
+    from 12 other addresses arrive 0.5 s apart, each subscribing 2 s after it connected (a person
+    picking topics): every one gets its 8,000 messages and none is closed -- a client within
+    its grace or with a subscription never makes room, the chatty idle ones do. The control that
+    shows the attack is real: the chatty clients held places (at least 8 open at once) and asked for
+    more than the per-address cap allows (`clients_per_address` counted); and the legitimate
+    clients past the first 8 could only be served by closing chatty ones (`clients` counted).
+    Before: every legitimate client refused "too many clients", and one that subscribed 2 s after
+    connecting was evicted."""
+    port, gateway, stats, view, ws_port = start_view(h)
+    url = f"ws://127.0.0.1:{ws_port}/"
+    sim = h.start("sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--count", "90000"])
+    chatty = h.start("chatty", [node(), ATTACK, "chatty", url, "16", "2", "127.0.0.2", "32000"])
+    time.sleep(11.0)  # past the grace: the chatty clients are idle now, whatever they send
+    late = []
+    for i in range(12):
+        # 8,000 messages (the two RobotState channels at 1 kHz: 4 s): the twelve overlap, so that
+        # the last ones find every place taken.
+        late.append(h.start(f"late{i}", [node(), ATTACK, "late", url, f"127.0.0.{10 + i}", "2000", "8000", "20000"]))
+        time.sleep(0.5)
+    for i, client in enumerate(late):
+        check(h.wait(f"late{i}", client, 30) == 0,
+              f"legitimate client {i} (subscribing after 2 s) was not served: {(h.dir / f'late{i}.err').read_text()}")
+    check(h.wait("chatty", chatty, 40) == 0, f"the chatty clients failed: {(h.dir / 'chatty.err').read_text()}")
+    result = json.loads(h.output("chatty").read_text().splitlines()[-1])
+    print(f"[{h.name}] chatty clients: {result}", flush=True)
+    check(h.stop("sim", sim) == 0, "rsg_sim did not exit 0 on SIGTERM")
+    check(h.stop("view", view) == 0, "rsg_view did not exit 0 on SIGTERM")
+    check(h.stop("gateway", gateway) == 0, "the gateway did not exit 0")
+    counts = limit_counts(h)
+    print(f"[{h.name}] limits: {counts}", flush=True)
+    check(result["opened"] >= 8, f"the attack did not hold its places: {result}")
+    check(counts["clients_per_address"] > 0 and counts["clients"] > 0, f"limits: {counts}")
+
+
 def attack_tcp(h):
     """1,100 TCP connections that never send a byte, from 10 addresses, and 100 from one of them, each
     renewed as soon as rsg_view closes it, for 8 s: rsg_view never holds more than --max-connections (64) of them, a
