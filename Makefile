@@ -175,8 +175,10 @@ format:
 clean:
 	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) build-demo build-fdds3 build-fdds214 build-time $(PKG_BUILD)
 
-# Fast DDS 3 (Debian 13's 3.1.2) in a cached trixie chroot, and across versions with $(BUILD)'s
-# 2.9.1 on the host (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/.
+# Fast DDS 3.6 (ROS 2 Lyrical's line: Debian experimental's 3.6.1 on Debian 13) in a cached chroot,
+# and across versions with $(BUILD)'s 2.9.1 and make test-fastdds214's 2.14.5 on the host
+# (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/; the 2.14 side is
+# make test-fastdds214's build-fdds214 (run that first: without it the 2.14 <-> 3.6 tests fail).
 .PHONY: test-fastdds3 bench-fastdds3
 test-fastdds3: build-tests
 	JOBS=$(JOBS) $(PRIVATE_SHM) tests/fastdds3/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds3.log

@@ -1,6 +1,8 @@
 #include "dds/internal/rtps_guard.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <limits>
 #include <mutex>
@@ -34,6 +36,16 @@
 
 #include <fastdds/rtps/common/LocatorList.hpp>
 #include <fastdds/rtps/common/LocatorSelector.hpp>
+#endif
+
+// Fast DDS 3.4 passes a writer's transport priority down to the transports (eProsima/Fast-DDS#5933):
+// ChainingTransport gained send_w_priority() and SenderResource a send() with the priority, the one
+// without it deprecated (an error under -Werror). 3.1.2 and 3.6.1 are the 3.x rsg builds on; 3.2
+// and 3.3 are taken for the old interface (unbuilt here).
+#if RSG_FASTDDS_MAJOR >= 3 && (FASTDDS_VERSION_MAJOR > 3 || FASTDDS_VERSION_MINOR >= 4)
+#define RSG_FASTDDS_TRANSPORT_PRIORITY 1
+#else
+#define RSG_FASTDDS_TRANSPORT_PRIORITY 0
 #endif
 
 namespace rsg::dds::internal {
@@ -96,12 +108,21 @@ class GuardTransport final : public ftransport::ChainingTransport {
             std::uint32_t total_bytes, rtps::LocatorsIterator* destinations_begin,
             rtps::LocatorsIterator* destinations_end,
             const std::chrono::steady_clock::time_point& timeout) override {
-    if (auto reachable = open_missing_channels(destinations_begin, destinations_end)) {
-      rtps::Locators first(reachable->cbegin()), last(reachable->cend());
-      return low_sender_resource->send(buffers, total_bytes, &first, &last, timeout);
-    }
-    return low_sender_resource->send(buffers, total_bytes, destinations_begin, destinations_end, timeout);
+    // Priority 0: what SenderResource's send without a priority passes on (Fast DDS 3.4 and later).
+    return send_guarded(low_sender_resource, buffers, total_bytes, destinations_begin, destinations_end,
+                        timeout, 0);
   }
+#if RSG_FASTDDS_TRANSPORT_PRIORITY
+  // What Fast DDS calls from 3.4 on: the writer's TransportPriorityQosPolicy reaches the low-level
+  // transport through the guard as it would without it (ChainingTransport's default drops it).
+  bool send_w_priority(rtps::SenderResource* low_sender_resource,
+                       const std::vector<rtps::NetworkBuffer>& buffers, std::uint32_t total_bytes,
+                       rtps::LocatorsIterator* destinations_begin, rtps::LocatorsIterator* destinations_end,
+                       const std::chrono::steady_clock::time_point& timeout, std::int32_t priority) override {
+    return send_guarded(low_sender_resource, buffers, total_bytes, destinations_begin, destinations_end,
+                        timeout, priority);
+  }
+#endif
 #else
   bool send(rtps::SenderResource* low_sender_resource, const rtps::octet* buffer, std::uint32_t size,
             rtps::LocatorsIterator* destinations_begin, rtps::LocatorsIterator* destinations_end,
@@ -125,6 +146,27 @@ class GuardTransport final : public ftransport::ChainingTransport {
   }
 
  private:
+#if RSG_FASTDDS_MAJOR >= 3
+  bool send_guarded(rtps::SenderResource* low_sender_resource,
+                    const std::vector<rtps::NetworkBuffer>& buffers, std::uint32_t total_bytes,
+                    rtps::LocatorsIterator* destinations_begin, rtps::LocatorsIterator* destinations_end,
+                    const std::chrono::steady_clock::time_point& timeout,
+                    [[maybe_unused]] std::int32_t priority) {
+    auto low_send = [&](rtps::LocatorsIterator* begin, rtps::LocatorsIterator* end) {
+#if RSG_FASTDDS_TRANSPORT_PRIORITY
+      return low_sender_resource->send(buffers, total_bytes, begin, end, timeout, priority);
+#else
+      return low_sender_resource->send(buffers, total_bytes, begin, end, timeout);
+#endif
+    };
+    if (auto reachable = open_missing_channels(destinations_begin, destinations_end)) {
+      rtps::Locators first(reachable->cbegin()), last(reachable->cend());
+      return low_send(&first, &last);
+    }
+    return low_send(destinations_begin, destinations_end);
+  }
+#endif
+
   /// Opens a channel for every destination that has none. Returns the destinations to send to
   /// when one of them could not be opened (a rare path: it allocates), else nothing.
   std::optional<std::vector<Locator>> open_missing_channels(rtps::LocatorsIterator* begin,
