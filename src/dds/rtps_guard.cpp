@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "dds/internal/rtps_screen.hpp"
+#include "dds/internal/transport_priority.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/error.hpp"
 
@@ -36,16 +37,6 @@
 
 #include <fastdds/rtps/common/LocatorList.hpp>
 #include <fastdds/rtps/common/LocatorSelector.hpp>
-#endif
-
-// Fast DDS 3.4 passes a writer's transport priority down to the transports (eProsima/Fast-DDS#5933):
-// ChainingTransport gained send_w_priority() and SenderResource a send() with the priority, the one
-// without it deprecated (an error under -Werror). 3.1.2 and 3.6.1 are the 3.x rsg builds on; 3.2
-// and 3.3 are taken for the old interface (unbuilt here).
-#if RSG_FASTDDS_MAJOR >= 3 && (FASTDDS_VERSION_MAJOR > 3 || FASTDDS_VERSION_MINOR >= 4)
-#define RSG_FASTDDS_TRANSPORT_PRIORITY 1
-#else
-#define RSG_FASTDDS_TRANSPORT_PRIORITY 0
 #endif
 
 namespace rsg::dds::internal {
