@@ -42,7 +42,7 @@ SHELL      := /bin/bash
 .SHELLFLAGS := -o pipefail -c
 
 
-.PHONY: all deps deps-test deps-run build build-tests build-demo install test test-long test-jazzy unit-asan fuzz fuzz-build demo bench format clean wireshark-plugin
+.PHONY: all deps deps-test deps-run build build-tests build-demo install test test-long unit-asan fuzz fuzz-build demo bench format clean wireshark-plugin
 
 all: build
 
@@ -62,8 +62,8 @@ endef
 deps-run:
 	$(call apt_install,build run)
 
-# Everything make test needs: Debian packages, npm packages, the Python environments (ROS 2 Kilted's
-# among them) and Go tools.
+# Everything make test needs: Debian packages, npm packages, the Python environments (ROS 2 Jazzy's
+# among them: its rclpy nodes and rosidl) and Go tools.
 deps-test: deps-run
 	$(call apt_install,test package)
 	@# Node and npm for the tests that read MCAP files with @mcap/core (Debian's, unless a node is there).
@@ -73,12 +73,10 @@ deps-test: deps-run
 	  npm ci --prefix tests/tools/record --no-audit --no-fund
 	@[ tests/tools/view/package-lock.json -ot tests/tools/view/node_modules/.package-lock.json ] || \
 	  npm ci --prefix tests/tools/view --no-audit --no-fund
-	@for script in tools/deps/*.sh; do DEPS_DIR=$(DEPS_DIR) RSG_ROS_DISTROS=kilted $$script || exit 1; done
+	@for script in tools/deps/*.sh; do DEPS_DIR=$(DEPS_DIR) $$script || exit 1; done
 
-# Everything every suite needs: deps-test and ROS 2 Jazzy's environment (make test-jazzy,
-# test-fastdds214, test-image, test-service, bench), which make test leaves out (its time budget).
+# Everything every suite needs: since ROS 2 Jazzy is make test's ROS 2 too, what deps-test installs.
 deps: deps-test
-	@for script in tools/deps/*.sh; do DEPS_DIR=$(DEPS_DIR) RSG_ROS_DISTROS="kilted jazzy" $$script || exit 1; done
 
 # The tests' build and the demo's are one tree with one set of flags: -O2 with line tables only
 # (-g1: file:line in every stack and sanitizer report, at about a third less compiling than full
@@ -124,10 +122,10 @@ fuzz-build: deps-test
 fuzz: fuzz-build
 	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_JOBS=$(JOBS) tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD) 2>&1 | tee $(FUZZ_BUILD)/fuzz.log
 
-# What a contributor runs: every ctest test but those labelled long or jazzy, side by side; the unit tests
+# What a contributor runs: every ctest test but those labelled long, side by side; the unit tests
 # again under ASan+UBSan; every fuzzer for TEST_FUZZ_SECONDS (docs/development.md has the time each part takes).
 test: build-tests
-	cd $(BUILD) && $(PRIVATE_SHM) ctest --output-on-failure -j $(CTEST_JOBS) -LE 'long|jazzy' 2>&1 | tee ctest.log && \
+	cd $(BUILD) && $(PRIVATE_SHM) ctest --output-on-failure -j $(CTEST_JOBS) -LE long 2>&1 | tee ctest.log && \
 	  echo "make test: ctest took $$SECONDS s"
 	$(MAKE) unit-asan
 	$(MAKE) fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS)
@@ -138,13 +136,6 @@ test: build-tests
 test-long: build-tests
 	cd $(BUILD) && $(PRIVATE_SHM) ctest --output-on-failure -j $(CTEST_JOBS) -L long 2>&1 | tee ctest-long.log
 	@tests/summarize.sh $(BUILD)/ctest-long.log --
-
-# The rclpy tests again with ROS 2 Jazzy nodes (ctest label jazzy, tests/ros2/CMakeLists.txt: rclpy
-# 7.1 on Fast DDS 2.14 from make deps' .deps/ros2-jazzy against the gateway); make test runs them
-# with Kilted's. A part of its own in .ci/run: together they would exceed make test's time budget.
-test-jazzy: deps build-tests
-	cd $(BUILD) && $(PRIVATE_SHM) ctest --output-on-failure -j $(CTEST_JOBS) -L jazzy 2>&1 | tee ctest-jazzy.log
-	@tests/summarize.sh $(BUILD)/ctest-jazzy.log --
 
 # Only what the demo runs, with only the build and run packages: in $(BUILD) with its flags, the
 # tests left unconfigured on a fresh tree (no GTest or benchmark needed yet) and kept on a tree
@@ -184,8 +175,10 @@ format:
 clean:
 	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) build-demo build-fdds3 build-fdds214 build-time $(PKG_BUILD)
 
-# Fast DDS 3 (Debian 13's 3.1.2) in a cached trixie chroot, and across versions with $(BUILD)'s
-# 2.9.1 on the host (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/.
+# Fast DDS 3.6 (ROS 2 Lyrical's line: Debian experimental's 3.6.1 on Debian 13) in a cached chroot,
+# and across versions with $(BUILD)'s 2.9.1 and make test-fastdds214's 2.14.5 on the host
+# (tests/fastdds3/run.sh, docs/fastdds-versions.md). Its own tree, build-fdds3/; the 2.14 side is
+# make test-fastdds214's build-fdds214 (run that first: without it the 2.14 <-> 3.6 tests fail).
 .PHONY: test-fastdds3 bench-fastdds3
 test-fastdds3: build-tests
 	JOBS=$(JOBS) $(PRIVATE_SHM) tests/fastdds3/run.sh $(BUILD) 2>&1 | tee $(BUILD)/test-fastdds3.log

@@ -1,27 +1,23 @@
-# Source me (bash or zsh): a project-local ROS 2 that `make deps` installs, Kilted or Jazzy.
+# Source me (bash or zsh): the project-local ROS 2 Jazzy (LTS, Fast DDS 2.14) that `make deps` installs.
 #
-#   . ros2/env.sh                        # ROS 2 Kilted (Fast DDS 3.2), the default
-#   RSG_ROS_DISTRO=jazzy . ros2/env.sh   # ROS 2 Jazzy LTS (Fast DDS 2.14)
+#   . ros2/env.sh
 #   python -c 'import rclpy; from rsg_msgs.msg import RobotState'
 #
-#                 Kilted                Jazzy
-# wheels          .deps/ros2            .deps/ros2-jazzy          the Python environment of the ROS 2
-#                                                                 wheels (tools/deps/python/ros2.txt,
-#                                                                 ros2-jazzy.txt): rclpy,
-#                                                                 rmw_fastrtps_cpp, std/sensor/
-#                                                                 geometry_msgs, rosidl
-# workspace       .deps/ros2_ws/install .deps/ros2_ws-jazzy/install  rsg_msgs (ros2/rsg_msgs) and
-#                                                                 tf2_msgs (tests/ros2/tf2_msgs) built
-#                                                                 by that distribution's ament_cmake
-#                                                                 + rosidl (tools/deps/ros2_ws.sh)
+# wheels     .deps/ros2-jazzy             the Python environment of the ROS 2 Jazzy wheels
+#                                         (tools/deps/python/ros2-jazzy.txt): rclpy, rmw_fastrtps_cpp,
+#                                         std/sensor/geometry_msgs, rosidl, ament_cmake
+# workspace  .deps/ros2_ws-jazzy/install  rsg_msgs (ros2/rsg_msgs) and tf2_msgs (tests/ros2/tf2_msgs)
+#                                         built by Jazzy's ament_cmake + rosidl (tools/deps/ros2_ws.sh)
+#
+# RSG_ROS_DISTRO names the distribution (jazzy, the only one): ROS 2 Kilted, which make deps
+# installed beside Jazzy until its end of life (November 2026), was retired (CHANGELOG.md).
 #
 # The wheels put their libraries in the environment's lib/ and in site-packages/ros_*.libs and
 # find packages through the ament index: this sets PATH, LD_LIBRARY_PATH, PYTHONPATH,
 # AMENT_PREFIX_PATH, CMAKE_PREFIX_PATH, ROS_DISTRO and RMW_IMPLEMENTATION=rmw_fastrtps_cpp. It also
 # tells the wheels' own start-up hook (ros_wheels_bootstrapper, which re-executes Python once to set
 # LD_LIBRARY_PATH) that this is done. ROS_DOMAIN_ID is left as it is: use the gateway's --domain.
-# Another environment: RSG_DEPS_DIR=/path/to/.deps before sourcing. Source it in a fresh shell to
-# change distribution: the two sets of libraries must not both be on LD_LIBRARY_PATH.
+# Another environment: RSG_DEPS_DIR=/path/to/.deps before sourcing.
 
 if [ -n "${BASH_SOURCE:-}" ]; then
   _rsg_ros2_here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
@@ -29,16 +25,20 @@ else
   _rsg_ros2_here=$(cd "$(dirname "$0")" && pwd)  # zsh sets $0 to the sourced file
 fi
 _rsg_deps=${RSG_DEPS_DIR:-$(dirname "$_rsg_ros2_here")/.deps}
-case ${RSG_ROS_DISTRO:-kilted} in
-  kilted) _rsg_suffix= ;;
+case ${RSG_ROS_DISTRO:-jazzy} in
   jazzy) _rsg_suffix=-jazzy ;;
+  kilted)
+    echo "ros2/env.sh: ROS 2 Kilted reached its end of life in November 2026 and make deps no longer installs it: use jazzy" >&2
+    unset _rsg_ros2_here _rsg_deps
+    return 1 2>/dev/null || exit 1
+    ;;
   *)
-    echo "ros2/env.sh: RSG_ROS_DISTRO=$RSG_ROS_DISTRO: make deps installs kilted (the default) and jazzy" >&2
+    echo "ros2/env.sh: RSG_ROS_DISTRO=$RSG_ROS_DISTRO: make deps installs jazzy only" >&2
     unset _rsg_ros2_here _rsg_deps
     return 1 2>/dev/null || exit 1
     ;;
 esac
-export RSG_ROS_DISTRO=${RSG_ROS_DISTRO:-kilted}
+export RSG_ROS_DISTRO=${RSG_ROS_DISTRO:-jazzy}
 export RSG_ROS2_VENV=$_rsg_deps/ros2$_rsg_suffix
 export RSG_ROS2_INSTALL=$_rsg_deps/ros2_ws$_rsg_suffix/install
 

@@ -1,6 +1,8 @@
 #include "dds/internal/rtps_guard.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <limits>
 #include <mutex>
@@ -12,6 +14,7 @@
 
 #include "dds/internal/rtps_screen.hpp"
 #include "dds/internal/spdp_admission.hpp"
+#include "dds/internal/transport_priority.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/error.hpp"
 
@@ -108,12 +111,21 @@ class GuardTransport final : public ftransport::ChainingTransport {
             std::uint32_t total_bytes, rtps::LocatorsIterator* destinations_begin,
             rtps::LocatorsIterator* destinations_end,
             const std::chrono::steady_clock::time_point& timeout) override {
-    if (auto reachable = open_missing_channels(destinations_begin, destinations_end)) {
-      rtps::Locators first(reachable->cbegin()), last(reachable->cend());
-      return low_sender_resource->send(buffers, total_bytes, &first, &last, timeout);
-    }
-    return low_sender_resource->send(buffers, total_bytes, destinations_begin, destinations_end, timeout);
+    // Priority 0: what SenderResource's send without a priority passes on (Fast DDS 3.4 and later).
+    return send_guarded(low_sender_resource, buffers, total_bytes, destinations_begin, destinations_end,
+                        timeout, 0);
   }
+#if RSG_FASTDDS_TRANSPORT_PRIORITY
+  // What Fast DDS calls from 3.4 on: the writer's TransportPriorityQosPolicy reaches the low-level
+  // transport through the guard as it would without it (ChainingTransport's default drops it).
+  bool send_w_priority(rtps::SenderResource* low_sender_resource,
+                       const std::vector<rtps::NetworkBuffer>& buffers, std::uint32_t total_bytes,
+                       rtps::LocatorsIterator* destinations_begin, rtps::LocatorsIterator* destinations_end,
+                       const std::chrono::steady_clock::time_point& timeout, std::int32_t priority) override {
+    return send_guarded(low_sender_resource, buffers, total_bytes, destinations_begin, destinations_end,
+                        timeout, priority);
+  }
+#endif
 #else
   bool send(rtps::SenderResource* low_sender_resource, const rtps::octet* buffer, std::uint32_t size,
             rtps::LocatorsIterator* destinations_begin, rtps::LocatorsIterator* destinations_end,
@@ -163,6 +175,27 @@ class GuardTransport final : public ftransport::ChainingTransport {
   }
 
  private:
+#if RSG_FASTDDS_MAJOR >= 3
+  bool send_guarded(rtps::SenderResource* low_sender_resource,
+                    const std::vector<rtps::NetworkBuffer>& buffers, std::uint32_t total_bytes,
+                    rtps::LocatorsIterator* destinations_begin, rtps::LocatorsIterator* destinations_end,
+                    const std::chrono::steady_clock::time_point& timeout,
+                    [[maybe_unused]] std::int32_t priority) {
+    auto low_send = [&](rtps::LocatorsIterator* begin, rtps::LocatorsIterator* end) {
+#if RSG_FASTDDS_TRANSPORT_PRIORITY
+      return low_sender_resource->send(buffers, total_bytes, begin, end, timeout, priority);
+#else
+      return low_sender_resource->send(buffers, total_bytes, begin, end, timeout);
+#endif
+    };
+    if (auto reachable = open_missing_channels(destinations_begin, destinations_end)) {
+      rtps::Locators first(reachable->cbegin()), last(reachable->cend());
+      return low_send(&first, &last);
+    }
+    return low_send(destinations_begin, destinations_end);
+  }
+#endif
+
   /// Hands on an announcement of a participant on probation with its lease cut to
   /// kProbationLease, from a copy (the received buffer is Fast DDS's, and read-only). False when
   /// the lease is short enough already: the caller hands on the original.

@@ -10,6 +10,7 @@
 #include <set>
 #include <vector>
 
+#include "dds/internal/transport_priority.hpp"
 #include "rsg/dds/fastdds.hpp"
 
 // The transport API is the one place of rsg's tests where Fast DDS 2 and 3 differ beyond names:
@@ -106,7 +107,12 @@ class SentDataRecordingTransport : public ftransport::ChainingTransport {
       message.insert(message.end(), bytes, bytes + buffer.size);
     }
     record_user_data(message.data(), message.size(), *descriptor_.sent);
+#if RSG_FASTDDS_TRANSPORT_PRIORITY
+    // Priority 0, as the deprecated send() passes; the recorder does not override send_w_priority().
+    return low_sender_resource->send(buffers, total_bytes, destinations_begin, destinations_end, timeout, 0);
+#else
     return low_sender_resource->send(buffers, total_bytes, destinations_begin, destinations_end, timeout);
+#endif
   }
 #else
   bool send(frtps::SenderResource* low_sender_resource, const frtps::octet* buffer, std::uint32_t size,

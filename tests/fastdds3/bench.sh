@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # make bench-fastdds3: make bench's e2e suite on Fast DDS 2.9 (the host's build) and then on 3.x
-# (Debian 13's 3.1.2, the chroot's build of tools/fastdds3/chroot.sh), one right after the other on
+# (3.6.1, the chroot's build of tools/fastdds3/chroot.sh; the committed runs were 3.1.2's), one right after the other on
 # one machine, and the two side by side (tests/bench/compare_fastdds.py); then the readers suite
-# (tests/bench/readers/readers.py) with a 2.9 gateway and with a 3.1.2 gateway (the readers run on
-# the host in both), and the churn suite (tests/bench/readers/churn.py) with a 3.1.2 gateway. The
+# (tests/bench/readers/readers.py) with a 2.9 gateway and with a 3.x gateway (the readers run on
+# the host in both), and the churn suite (tests/bench/readers/churn.py) with a 3.x gateway. The
 # committed runs and what they say: docs/benchmarks/fastdds3/, docs/benchmarks/readers/.
 #
 #   tests/fastdds3/bench.sh [HOST_BUILD [SUITE...]]   HOST_BUILD: the host's 2.9 build tree (default
@@ -39,12 +39,12 @@ $chroot mixed "$gateway3" "$PWD/$host_build" "$PWD/$build" rsg_gateway
 if [[ " ${suites[*]} " == *" readers "* ]]; then
   python3 tests/bench/readers/readers.py --bin "$host_build/bin" --label fastdds2.9 --out "$build/bench/readers"
   python3 tests/bench/readers/readers.py --bin "$host_build/bin" --gateway "$gateway3/rsg_gateway" \
-    --label fastdds3.1.2 --reader-qos reader_realtime_udp --out "$build/bench/readers"
+    --label fastdds3 --reader-qos reader_realtime_udp --out "$build/bench/readers"
 fi
 if [[ " ${suites[*]} " == *" churn "* ]]; then
-  # make bench's churn suite with a 3.x gateway (2.9 readers on the host, rclpy's Fast DDS 3.2).
+  # make bench's churn suite with a 3.x gateway (2.9 readers on the host, Jazzy rclpy's Fast DDS 2.14).
   RSG_DEPS_DIR=$(sed -n 's/^RSG_DEPS_DIR:PATH=//p' "$host_build/CMakeCache.txt") \
-    python3 tests/bench/readers/churn.py --bin "$gateway3" --label fastdds3.1.2 --out "$build/bench/churn" \
+    python3 tests/bench/readers/churn.py --bin "$gateway3" --label fastdds3 --out "$build/bench/churn" \
     --runs "${RSG_BENCH_CHURN_RUNS:-3}" --gateway-args "${RSG_BENCH_CHURN_GATEWAY_ARGS:---rt-priority 30}"
 fi
 [[ " ${suites[*]} " == *" e2e "* ]] || exit 0

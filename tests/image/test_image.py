@@ -15,9 +15,9 @@ over loopback and the host's /dev/shm (what docker/compose.yaml sets).
                 effect) and restarted by the engine itself: the running echo and recorder resume,
                 and every sample the echo printed is one rsg_sim sent, in order
   ros2_type_hash
-                the image's gateway run with --ros2 and the standard topics, read by a Kilted and
-                a Jazzy rclpy node (make deps' ROS 2 environments on the host): rosidl's RIHS01 type
-                hash, as each computes it, on each of its five ROS 2 writers
+                the image's gateway run with --ros2 and the standard topics, read by a
+                ROS 2 Jazzy rclpy node (make deps' ROS 2 environment on the host): rosidl's RIHS01 type
+                hash, as Jazzy's rosidl computes it, on each of its five ROS 2 writers
   dds_attacks   the image's gateway at 500 Hz with a reader, then the Fast DDS attacks of
                 tests/support/dds_attacks.py from the host (the 84-byte statistics datagram on every
                 port of the domain, two readers of the image on a unicast and a multicast locator,
@@ -530,17 +530,16 @@ def fetch(url):
 def ros2_type_hash(c):
     """The image was built without ROS 2: its gateway, run with --ros2 and the standard topics, is
     seen by a real rclpy node (make deps' ROS 2 environment on the host) with rosidl's RIHS01 type
-    hash on every writer, where it once showed INVALID: a Kilted and a Jazzy node, as each computes it."""
+    hash on every writer, where it once showed INVALID: a ROS 2 Jazzy node, as its rosidl computes it."""
     sys.path.insert(0, str(ROOT / "tests" / "ros2"))
     from rclpy_common import RosEnv, check_rosidl_type_hashes  # noqa: E402 (the ROS 2 environment only here)
     c.start("gateway", "--listen", f"127.0.0.1:{free_udp_port()}", "--domain", c.domain, "--ros2",
             "--joint-states", "100", "--tf", "every:5", "--external-wrench", "50",
             mounts=[f"{c.stats_dir}:{STATS_DIR}"])
     wait_for_stats(c.stats, lambda s: True, "the gateway container to start", timeout_s=60)
-    for distro in ("kilted", "jazzy"):
-        checked = check_rosidl_type_hashes(RosEnv(c.domain, distro))
-        print(f"[image] ros2_type_hash: rosidl's hash on all {checked} ROS 2 writers of the image's gateway, "
-              f"seen by a {distro} node", flush=True)
+    checked = check_rosidl_type_hashes(RosEnv(c.domain, "jazzy"))
+    print(f"[image] ros2_type_hash: rosidl's hash on all {checked} ROS 2 writers of the image's gateway, "
+          f"seen by a jazzy node", flush=True)
 
 
 CASES = {"pipeline": pipeline, "health": health, "view_and_restart": view_and_restart, "compose": compose,

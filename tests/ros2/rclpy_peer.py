@@ -43,7 +43,7 @@ except ImportError:  # Jazzy's rclpy (7.1) has no content filter API: rcl's C AP
 
 
 def filter_options(expression, parameters=()):
-    """create_subscription's keyword arguments for a content filter, where rclpy has the API (Kilted)."""
+    """create_subscription's keyword arguments for a content filter, where rclpy has the API (from Kilted's rclpy 9 on: Lyrical's too)."""
     if expression is None or ContentFilterOptions is None:
         return {}
     return {"content_filter_options": ContentFilterOptions(filter_expression=expression,

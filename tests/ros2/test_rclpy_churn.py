@@ -2,7 +2,7 @@
 crashes, stalls or loses a frame for its other readers.
 
 rsg_gateway --ros2 gets 3000 frames from rsg_sim at 200 Hz (15 s). Meanwhile one process runs 50
-times: rclpy.init (a new participant: Fast DDS 3.2 on Kilted, 2.14 on Jazzy), a node with a default-QoS RobotState subscription,
+times: rclpy.init (a new participant: Fast DDS 2.14 on Jazzy), a node with a default-QoS RobotState subscription,
 wait until it matched and got a message, shutdown (the participant leaves); and three more rclpy
 subscribers are killed with SIGKILL (they vanish without saying goodbye: the gateway learns of it by
 lease expiry). A reliable keep-all rclpy subscription that stays all along gets every frame, in
@@ -62,7 +62,7 @@ def body(h):
         victim.send_signal(signal.SIGKILL)
         victim.wait()
 
-    # The churning peer's own Fast DDS (3.2.3 on Kilted) can crash in destroy_node when a node leaves
+    # The churning peer's own Fast DDS (seen with Kilted's 3.2.3, before Kilted was retired) can crash in destroy_node when a node leaves
     # while discovery still pairs its endpoints (SIGSEGV in rclpy's destroy_node, seen once in a CI-like
     # run; docs/operating.md, "A reader deleted while it is being matched"). That is the peer's, not the
     # gateway's: a new process churns the nodes still to come, at most MAX_PEER_CRASHES times, and the

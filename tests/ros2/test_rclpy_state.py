@@ -1,6 +1,6 @@
-"""rsg_gateway --ros2 read by real ROS 2 nodes: rclpy on rmw_fastrtps_cpp (Kilted: Fast DDS 3.2; Jazzy
-with RSG_ROS_DISTRO=jazzy: Fast DDS 2.14) with the rsg_msgs that the distribution's ament_cmake + rosidl
-built (make deps), against the gateway's own Fast DDS (Debian 12's 2.9.1).
+"""rsg_gateway --ros2 read by real ROS 2 nodes: rclpy on rmw_fastrtps_cpp (ROS 2 Jazzy:
+Fast DDS 2.14) with the rsg_msgs that Jazzy's ament_cmake + rosidl built (make deps), against the
+gateway's own Fast DDS (Debian 12's 2.9.1; a 3.6 gateway in make test-fastdds3).
 
 In the root namespace and in /robot1, fed by rsg_sim:
 - a subscription with rclpy's default QoS (reliable, volatile, keep last 10) gets the stream in

@@ -4,7 +4,7 @@ ones rosidl computes, for every type rsg_gateway publishes: rsg_msgs' RobotState
 rosidl_adapter and rosidl_generator_type_description from the repository's .msg) and
 GatewayStatus, and the standard sensor_msgs/JointState, tf2_msgs/TFMessage and
 geometry_msgs/WrenchStamped (rosidl's type descriptions of the ROS 2 wheels and of make deps'
-tf2_msgs build; Kilted's rosidl, or Jazzy's with RSG_ROS_DISTRO=jazzy). Needs make deps' ROS 2 environment; fails saying so without it.
+tf2_msgs build; Jazzy's rosidl). Needs make deps' ROS 2 environment; fails saying so without it.
 
 RSG_TYPE_HASHES_HEADER names the header the build generated (CMake sets it). docs/ros2.md's table of
 the hashes must list the same.

@@ -31,8 +31,8 @@ the ones before left:
                 instance whose file was broken meanwhile does not come back: postinst names it
                 (and the one it restarted), the install fails, and `dpkg --configure -a`
                 finishes once the file is fixed
-  ros2_type_hash  a second instance with --ros2 and the standard topics: a Kilted and a Jazzy
-                rclpy node on the host (make deps' ROS 2 environments) see rosidl's RIHS01 hash on all
+  ros2_type_hash  a second instance with --ros2 and the standard topics: a ROS 2 Jazzy
+                rclpy node on the host (make deps' ROS 2 environment) sees rosidl's RIHS01 hash on all
                 five writers
   broken        an instance with a configuration the gateway refuses: its start fails, the error
                 is in `journalctl -u` at priority err, the exit status is 2 and systemd does not
@@ -463,14 +463,14 @@ class Run:
     def ros2_type_hash(self):
         """The packaged gateway as a second instance with --ros2 and the standard topics: a real rclpy
         node on the host (make deps' ROS 2 environment) sees rosidl's RIHS01 type hash on every
-        ROS 2 writer, computed at the package's build without ROS 2: a Kilted and a Jazzy node."""
+        ROS 2 writer, computed at the package's build without ROS 2: a ROS 2 Jazzy node."""
         sys.path.insert(0, str(ROOT / "tests" / "ros2"))
         from rclpy_common import RosEnv, check_rosidl_type_hashes  # noqa: E402 (the ROS 2 environment only here)
         self.box.sh(f"printf 'listen: 127.0.0.1:{free_udp_port()}\\ndomain: {self.domain}\\nros2: true\\n"
                     f"joint-states: \"100\"\\ntf: \"every:5\"\\nexternal-wrench: \"50\"\\n' > /etc/rsg/{ROS2_INSTANCE}.yaml")
         self.box.sh(f"systemctl start {ROS2_UNIT}")
         try:
-            checked = {distro: check_rosidl_type_hashes(RosEnv(self.domain, distro)) for distro in ("kilted", "jazzy")}
+            checked = {distro: check_rosidl_type_hashes(RosEnv(self.domain, distro)) for distro in ("jazzy",)}
         finally:
             self.box.sh(f"systemctl stop {ROS2_UNIT}; rm -f /etc/rsg/{ROS2_INSTANCE}.yaml", check_status=False)
         print(f"[service] ros2_type_hash: rosidl's hash on all ROS 2 writers of the packaged gateway "

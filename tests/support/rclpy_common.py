@@ -1,8 +1,8 @@
-"""What the rclpy tests share: the project's ROS 2 environment (make deps: .deps/ros2 and
-.deps/ros2_ws/install for Kilted, .deps/ros2-jazzy and .deps/ros2_ws-jazzy/install for Jazzy, set up
-by ros2/env.sh), starting rclpy_peer.py in it, and rsg_sim's canonical JSON as the RobotState message
-a ROS 2 node must see. The distribution is RSG_ROS_DISTRO's (kilted when unset), as for ros2/env.sh:
-ctest registers each rclpy test once per distribution (tests/ros2/CMakeLists.txt).
+"""What the rclpy tests share: the project's ROS 2 environment (make deps: .deps/ros2-jazzy and
+.deps/ros2_ws-jazzy/install for ROS 2 Jazzy, set up by ros2/env.sh), starting rclpy_peer.py in it, and
+rsg_sim's canonical JSON as the RobotState message a ROS 2 node must see. The distribution is
+RSG_ROS_DISTRO's (jazzy when unset, the only one make deps installs since Kilted was retired), as for
+ros2/env.sh.
 
 The tests themselves run under any Python 3 (ctest's); only rclpy_peer.py runs in the ROS 2
 environment, on the test's DDS domain (ROS_DOMAIN_ID = the gateway's --domain).
@@ -27,7 +27,7 @@ class RosEnv:
 
     def __init__(self, domain, distro=None):
         deps = os.environ.get("RSG_DEPS_DIR") or str(REPO / ".deps")
-        self.distro = distro or os.environ.get("RSG_ROS_DISTRO") or "kilted"
+        self.distro = distro or os.environ.get("RSG_ROS_DISTRO") or "jazzy"
         shell = subprocess.run(["bash", "-c", f'. "{REPO}/ros2/env.sh" > /dev/null && env -0'],
                                env={**os.environ, "RSG_DEPS_DIR": deps, "RSG_ROS_DISTRO": self.distro},
                                capture_output=True)

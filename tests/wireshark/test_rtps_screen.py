@@ -13,6 +13,9 @@ RTPS dissector, through Debian's tshark.
    no malformed packet and no expert error in it. The control: the same mutants unscreened, where
    tshark must find malformed packets (the mutants are broken in ways the oracle sees), and the
    screen must have refused some of them.
+4. A bounded run against a live gateway: every mutant sent to every port of the domain while the
+   gateway publishes at 1 kHz to a reader; it keeps publishing, the reader keeps its samples, and
+   rsg_dds_screen_dropped_total counts what the screen refused.
 
     tests/wireshark/test_rtps_screen.py --bin build/bin --test-bin build/tests/bin
 """
@@ -23,7 +26,9 @@ import struct
 import subprocess
 import sys
 
-from harness import check, main, wait_for, wait_for_stats, free_udp_port  # noqa: E402
+from harness import check, main, read_json, wait_for, wait_for_stats, free_udp_port  # noqa: E402
+from metrics_support import free_tcp_port, http_get, parse_samples  # noqa: E402
+from dds_attacks import send_to_domain  # noqa: E402
 
 import pcap_file  # noqa: E402
 import tshark_run  # noqa: E402
@@ -228,6 +233,29 @@ def body(h):
     after = flagged(h, "screened", forwarded)
     check(not after, f"tshark flags {len(after)} datagrams the screen handed on: "
           + "; ".join(f"{msgs} in {forwarded[n - 1].hex()}" for n, msgs in sorted(after.items())[:3]))
+    against_live_gateway(h, mutants[:3000])
+
+
+def against_live_gateway(h, mutants):
+    port, metrics_port = free_udp_port(), free_tcp_port()
+    gateway, stats = h.gateway("live", "--listen", f"127.0.0.1:{port}", "--expected-rate", "1000",
+                               "--metrics", f"127.0.0.1:{metrics_port}")
+    wait_for_stats(stats, lambda s: True, "the live gateway to start")
+    h.start("live_sim", [h.binary("rsg_sim"), "--to", f"127.0.0.1:{port}", "--rate", "1000", "--duration", "40"])
+    reader = h.start("live_reader", [h.binary("rsg_echo"), "--domain", str(h.domain), "--json", "--timeout", "45"])
+    wait_for_stats(stats, lambda s: s["state_readers"] >= 1 and s["frames_published"] > 500,
+                   "the live gateway's reader to match and frames to be published")
+    send_to_domain(h.domain, mutants)
+    check(gateway.poll() is None, f"the live gateway died of the mutants (exit {gateway.returncode})")
+    before = read_json(stats)["frames_published"]
+    wait_for_stats(stats, lambda s: s["frames_published"] >= before + 500, "the live gateway to go on publishing")
+    check(reader.poll() is None, f"the live gateway's reader stopped (exit {reader.returncode})")
+    reply = http_get(metrics_port, "/metrics")
+    check(reply is not None and reply[0] == 200, f"/metrics did not answer: {reply}")
+    dropped = sum(v for n, _, v in parse_samples(reply[1]) if n == "rsg_dds_screen_dropped_total")
+    check(dropped > 0, "rsg_dds_screen_dropped_total counted nothing of the mutants")
+    print(f"[rtps_screen] the live gateway kept publishing; its screen refused {dropped:.0f} messages", flush=True)
+    check(h.stop("live", gateway) == 0, "the live gateway did not exit 0 on SIGTERM")
 
 
 if __name__ == "__main__":

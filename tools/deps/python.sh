@@ -8,13 +8,8 @@ cd "$(dirname "$0")/../.."
 deps_dir=${DEPS_DIR:-$PWD/.deps}
 python=${RSG_DEPS_PYTHON:-/usr/bin/python3}
 shopt -s nullglob
-# RSG_ROS_DISTROS: the ROS 2 distributions whose environment to make (default both; make test needs
-# Kilted's only, the Jazzy suites Jazzy's: the Makefile's deps-test and deps).
-distros=" ${RSG_ROS_DISTROS:-kilted jazzy} "
 for requirements in tools/deps/python/*.txt; do
   name=$(basename "$requirements" .txt)
-  [[ $name != ros2-jazzy || $distros == *" jazzy "* ]] || continue
-  [[ $name != ros2 || $distros == *" kilted "* ]] || continue
   env_dir=$deps_dir/$name
   stamp=$(sha256sum "$requirements" | cut -d' ' -f1)
   [[ -f $env_dir/.rsg-stamp && $(<"$env_dir/.rsg-stamp") == "$stamp" ]] && continue

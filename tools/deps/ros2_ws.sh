@@ -1,12 +1,11 @@
 #!/usr/bin/env bash
-# The project's ROS 2 workspaces, one per distribution: rsg_msgs (ros2/rsg_msgs) and tf2_msgs
-# (tests/ros2/tf2_msgs, no wheel of it exists) built by the real ROS 2 pipeline, that distribution's
-# ament_cmake + rosidl_default_generators from its wheels (made by python.sh before this), each
-# installed into one prefix:
-#   Kilted  .deps/ros2        (tools/deps/python/ros2.txt)        -> .deps/ros2_ws/install
+# The project's ROS 2 workspace: rsg_msgs (ros2/rsg_msgs) and tf2_msgs (tests/ros2/tf2_msgs, no
+# wheel of it exists) built by the real ROS 2 pipeline, ROS 2 Jazzy's ament_cmake +
+# rosidl_default_generators from its wheels (made by python.sh before this), installed into one prefix:
 #   Jazzy   .deps/ros2-jazzy  (tools/deps/python/ros2-jazzy.txt)  -> .deps/ros2_ws-jazzy/install
-# ros2/env.sh puts one of them on the paths (RSG_ROS_DISTRO). A workspace is built again only when
-# a package's files, its wheels' pins or this script changed.
+# ros2/env.sh puts it on the paths. The workspace is built again only when a package's files, its
+# wheels' pins or this script changed. (A workspace per distribution: the layout keeps the name of
+# the one it was built by, so that another distribution's, should one come, sits beside it.)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 deps_dir=${DEPS_DIR:-$PWD/.deps}
@@ -62,7 +61,12 @@ build_workspace() {
   )
 }
 
-# RSG_ROS_DISTROS as in python.sh.
-distros=" ${RSG_ROS_DISTROS:-kilted jazzy} "
-[[ $distros != *" kilted "* ]] || build_workspace "$deps_dir/ros2" "$deps_dir/ros2_ws" tools/deps/python/ros2.txt
-[[ $distros != *" jazzy "* ]] || build_workspace "$deps_dir/ros2-jazzy" "$deps_dir/ros2_ws-jazzy" tools/deps/python/ros2-jazzy.txt
+# ROS 2 Kilted's environment and workspace, which make deps made until Kilted's end of life
+# (November 2026): removed, so that no test or script finds a retired distribution by accident.
+for retired in "$deps_dir/ros2" "$deps_dir/ros2_ws"; do
+  if [[ -f $retired/.rsg-stamp ]]; then
+    echo "make deps: removing ROS 2 Kilted's $retired (retired)"
+    rm -rf "$retired"
+  fi
+done
+build_workspace "$deps_dir/ros2-jazzy" "$deps_dir/ros2_ws-jazzy" tools/deps/python/ros2-jazzy.txt

@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# The Debian 13 (trixie) test bed of the Fast DDS 3 build (docs/fastdds-versions.md).
+# The Debian 13 (trixie) test bed of the Fast DDS 3 build (docs/fastdds-versions.md): Fast DDS 3.6.1
+# from Debian experimental, with Fast CDR 2.3 and fastddsgen 4.3 from unstable, on trixie
+# (tools/fastdds3/apt-preferences says which package comes from which suite).
 #
 #   tools/fastdds3/chroot.sh setup         make the chroot once (cached), install docker/packages/trixie.txt
 #   tools/fastdds3/chroot.sh run CMD...    run CMD on the host with the chroot's file systems mounted
@@ -34,6 +36,7 @@ source "$checkout/tools/apt_sources.sh"  # debian_mirror
 # RSG_TRIXIE_MIRROR; looked up where it is needed (setup), since `run` and `in` need none.
 mirror=${RSG_TRIXIE_MIRROR:-}
 packages_file=$checkout/docker/packages/trixie.txt
+preferences_file=$checkout/tools/fastdds3/apt-preferences
 
 die() { echo "chroot.sh: $*" >&2; exit 1; }
 [[ $(id -u) == 0 ]] || die "needs root (debootstrap, chroot, mount)"
@@ -59,10 +62,20 @@ setup() {
     mv "$root.tmp" "$root"
   fi
   local stamp
-  stamp=$(sha256sum "$packages_file" | cut -d' ' -f1)
+  stamp=$(cat "$packages_file" "$preferences_file" | sha256sum | cut -d' ' -f1)
   if [[ ! -f $root/.rsg-packages || $(<"$root/.rsg-packages") != "$stamp" ]]; then
     local packages
     packages=$(grep -v '^\s*#' "$packages_file" | xargs)
+    # unstable and experimental beside trixie, from the same mirror, pinned by the preferences file.
+    # Their Release files carry a Valid-Until a week ahead (trixie's, a stable release's, none), which
+    # a mirror or proxy that serves a snapshot is past: that check is off for these two suites only;
+    # the signatures are still checked.
+    [[ -n $mirror ]] || mirror=$(debian_mirror trixie bookworm) ||
+      die "no Debian trixie or bookworm source in /etc/apt: which mirror? (RSG_TRIXIE_MIRROR=URI)"
+    printf 'Types: deb\nURIs: %s\nSuites: unstable experimental\nComponents: main\nCheck-Valid-Until: no\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' \
+      "$mirror" > "$root/etc/apt/sources.list.d/rsg-fastdds.sources"
+    mkdir -p "$root/etc/apt/preferences.d"
+    grep -v '^#' "$preferences_file" > "$root/etc/apt/preferences.d/rsg-fastdds"
     echo "chroot.sh: installing into the chroot: $packages"
     in_chroot sh -c "apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
       --no-install-recommends $packages > /tmp/rsg-apt.log 2>&1 || { tail -30 /tmp/rsg-apt.log; exit 1; }"

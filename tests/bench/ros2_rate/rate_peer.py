@@ -1,5 +1,5 @@
 """The ROS 2 side of make bench's ros2_rate suite (ros2_rate.py): a plain rclpy node, run with the
-Python of the project's ROS 2 environment (ros2/env.sh, Kilted or Jazzy), never imported.
+Python of the project's ROS 2 environment (ros2/env.sh: Jazzy), never imported.
 
   sub --topic T --settle S --seconds S
       one subscription of rsg_msgs/msg/RobotState with rclpy's default QoS (reliable, volatile,
