@@ -25,6 +25,7 @@
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/log/Log.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
@@ -52,6 +53,7 @@ int main(int argc, char** argv) {
   std::string profiles;
   std::string participant_profile;
   double duration_s = 60;
+  bool warnings = false;
   CLI::App app("A plain Fast DDS participant with a RobotState reader, none of rsg's defences",
                "rsg_fastdds_flaws_probe");
   app.add_option("--domain", domain);
@@ -59,6 +61,7 @@ int main(int argc, char** argv) {
   app.add_option("--profiles", profiles, "An XML profile file, loaded by Fast DDS itself");
   app.add_option("--participant-profile", participant_profile, "A participant profile of --profiles");
   app.add_option("--duration", duration_s, "Seconds to run");
+  app.add_flag("--warnings", warnings, "Fast DDS's warnings too (its default: errors only)");
   CLI11_PARSE(app, argc, argv);
 
 #if RSG_FASTDDS_MAJOR >= 3
@@ -66,6 +69,7 @@ int main(int argc, char** argv) {
 #else
   say(std::string("fastdds ") + FASTRTPS_VERSION_STR);
 #endif
+  if (warnings) fdds::Log::SetVerbosity(fdds::Log::Kind::Warning);
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   if (!profiles.empty() && factory->load_XML_profiles_file(profiles) != rsg::dds::kOk) {
     say("Fast DDS did not load " + profiles);

