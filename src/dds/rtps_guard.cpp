@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "dds/internal/rtps_screen.hpp"
+#include "dds/internal/spdp_admission.hpp"
 #include "rsg/dds/fastdds.hpp"
 #include "rsg/error.hpp"
 
@@ -44,12 +45,15 @@ using Locator = rtps::Locator_t;
 
 struct GuardDescriptor : public ftransport::ChainingTransportDescriptor {
   GuardDescriptor(std::shared_ptr<ftransport::TransportDescriptorInterface> low_level,
-                  std::shared_ptr<RtpsGuardCounts> counts)
-      : ChainingTransportDescriptor(std::move(low_level)), counts(std::move(counts)) {}
+                  std::shared_ptr<RtpsGuardCounts> counts, std::shared_ptr<SpdpAdmission> admission)
+      : ChainingTransportDescriptor(std::move(low_level)),
+        counts(std::move(counts)),
+        admission(std::move(admission)) {}
 
   ftransport::TransportInterface* create_transport() const override;
 
   std::shared_ptr<RtpsGuardCounts> counts;
+  std::shared_ptr<SpdpAdmission> admission;  // one per participant, whichever transport receives
 };
 
 /// Calls `visit` with each destination of a send, on a copy of the caller's iterator (the low-level
@@ -70,7 +74,10 @@ void visit_destinations(rtps::LocatorsIterator* begin, rtps::LocatorsIterator* e
       visit_destinations_as<rtps::LocatorSelector::iterator>(begin, end, visit);
 }
 
-/// UDP behind the guard. Receiving: the statistics submessage is cut off (rtps_screen.hpp).
+constexpr std::uint32_t kRtpsHeaderBytes = 20;
+
+/// UDP behind the guard. Receiving: every datagram screened (rtps_screen.hpp): what fails a check
+/// and a statistics submessage are cut off, a datagram with nothing valid left is dropped.
 /// Sending: Fast DDS before 2.14.5 / 3.1.3 sends to a reader locator it opened no output channel
 /// for when a reader announces both unicast and multicast locators, and the UDP transport's
 /// statistics then assert (OutputTrafficManager::set_statistics_message_data) or read end() in a
@@ -79,7 +86,12 @@ void visit_destinations(rtps::LocatorsIterator* begin, rtps::LocatorsIterator* e
 class GuardTransport final : public ftransport::ChainingTransport {
  public:
   explicit GuardTransport(const GuardDescriptor& descriptor)
-      : ChainingTransport(descriptor), descriptor_(descriptor), counts_(*descriptor_.counts) {}
+      : ChainingTransport(descriptor),
+        descriptor_(descriptor),
+        counts_(*descriptor_.counts),
+        admission_(*descriptor_.admission) {
+    rewritten_.reserve(kMaxDatagramBytes);
+  }
 
   ftransport::TransportDescriptorInterface* get_configuration() override { return &descriptor_; }
 
@@ -117,14 +129,69 @@ class GuardTransport final : public ftransport::ChainingTransport {
   void receive(ftransport::TransportReceiverInterface* next_receiver, const rtps::octet* buffer,
                std::uint32_t size, const Locator& local_locator, const Locator& remote_locator) override {
     const RtpsScreen screen = screen_rtps_datagram(buffer, size);
-    if (screen.cut == RtpsScreen::Cut::kTrailing)
-      counts_.statistics_removed.fetch_add(1, std::memory_order_relaxed);
-    if (screen.cut == RtpsScreen::Cut::kMisplaced)
-      counts_.statistics_misplaced.fetch_add(1, std::memory_order_relaxed);
+    switch (screen.cut) {
+      case RtpsScreen::Cut::kNone:
+        break;
+      case RtpsScreen::Cut::kTrailing:
+        counts_.statistics_removed.fetch_add(1, std::memory_order_relaxed);
+        break;
+      case RtpsScreen::Cut::kMisplaced:
+        counts_.statistics_misplaced.fetch_add(1, std::memory_order_relaxed);
+        break;
+      case RtpsScreen::Cut::kInvalid:
+        counts_.screened_out[static_cast<std::size_t>(screen.reason)].fetch_add(1, std::memory_order_relaxed);
+        break;
+    }
+    if (screen.forward_bytes <= kRtpsHeaderBytes) return;  // nothing Fast DDS may read is left
+    AnnouncementSource source;
+    std::copy(std::begin(remote_locator.address), std::end(remote_locator.address), source.address.begin());
+    source.port = remote_locator.port;
+    const auto decision = admission_.admit(buffer, screen.forward_bytes, source, SpdpAdmission::Clock::now());
+    switch (decision.verdict) {
+      case SpdpAdmission::Verdict::kPass:
+        break;
+      case SpdpAdmission::Verdict::kRefuse:
+        counts_.announcements_refused.fetch_add(1, std::memory_order_relaxed);
+        return;
+      case SpdpAdmission::Verdict::kShortLease:
+        if (shorten_lease(next_receiver, buffer, screen.forward_bytes, decision, local_locator,
+                          remote_locator))
+          return;
+        break;
+    }
     next_receiver->OnDataReceived(buffer, screen.forward_bytes, local_locator, remote_locator);
   }
 
  private:
+  /// Hands on an announcement of a participant on probation with its lease cut to
+  /// kProbationLease, from a copy (the received buffer is Fast DDS's, and read-only). False when
+  /// the lease is short enough already: the caller hands on the original.
+  bool shorten_lease(ftransport::TransportReceiverInterface* next_receiver, const rtps::octet* buffer,
+                     std::uint32_t size, const SpdpAdmission::Decision& decision,
+                     const Locator& local_locator, const Locator& remote_locator) {
+    const std::uint32_t at = decision.lease_at;
+    const auto read32 = [&](std::uint32_t offset) {
+      const rtps::octet* b = buffer + offset;
+      return decision.lease_little_endian ? std::uint32_t{b[0]} | std::uint32_t{b[1]} << 8 |
+                                                std::uint32_t{b[2]} << 16 | std::uint32_t{b[3]} << 24
+                                          : std::uint32_t{b[3]} | std::uint32_t{b[2]} << 8 |
+                                                std::uint32_t{b[1]} << 16 | std::uint32_t{b[0]} << 24;
+    };
+    const auto limit = static_cast<std::int32_t>(kProbationLease.count());
+    const auto seconds = static_cast<std::int32_t>(read32(at));
+    if (seconds >= 0 && seconds < limit) return false;
+    std::lock_guard lock(rewrite_mutex_);
+    rewritten_.assign(buffer, buffer + size);
+    for (int i = 0; i < 4; ++i) {
+      const int shift = decision.lease_little_endian ? 8 * i : 8 * (3 - i);
+      rewritten_[at + i] = static_cast<rtps::octet>(static_cast<std::uint32_t>(limit) >> shift);
+      rewritten_[at + 4 + i] = 0;  // no fraction
+    }
+    counts_.leases_shortened.fetch_add(1, std::memory_order_relaxed);
+    next_receiver->OnDataReceived(rewritten_.data(), size, local_locator, remote_locator);
+    return true;
+  }
+
   /// Opens a channel for every destination that has none. Returns the destinations to send to
   /// when one of them could not be opened (a rare path: it allocates), else nothing.
   std::optional<std::vector<Locator>> open_missing_channels(rtps::LocatorsIterator* begin,
@@ -153,8 +220,13 @@ class GuardTransport final : public ftransport::ChainingTransport {
     return reachable;
   }
 
+  static constexpr std::size_t kMaxDatagramBytes = 65536;
+
   GuardDescriptor descriptor_;
   RtpsGuardCounts& counts_;
+  SpdpAdmission& admission_;
+  std::mutex rewrite_mutex_;            // receive threads of this transport's sockets
+  std::vector<rtps::octet> rewritten_;  // reserved once: an announcement never exceeds a datagram
   std::mutex mutex_;
   std::set<Locator> opened_;  // every locator the low-level transport opened a channel for
 };
@@ -217,8 +289,10 @@ void make_builtins_explicit(eprosima::fastdds::dds::DomainParticipantQos& qos) {
 void guard_transports(eprosima::fastdds::dds::DomainParticipantQos& qos,
                       std::shared_ptr<RtpsGuardCounts> counts) {
   if (qos.transport().use_builtin_transports) make_builtins_explicit(qos);
+  auto admission = std::make_shared<SpdpAdmission>();
   for (auto& descriptor : qos.transport().user_transports) {
-    if (descriptor && is_udp(*descriptor)) descriptor = std::make_shared<GuardDescriptor>(descriptor, counts);
+    if (descriptor && is_udp(*descriptor))
+      descriptor = std::make_shared<GuardDescriptor>(descriptor, counts, admission);
   }
 }
 

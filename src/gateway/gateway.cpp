@@ -480,7 +480,11 @@ MetricsSnapshot Gateway::metrics_snapshot(const status::GatewayStats& stats, Clo
   metrics.dds_guard = DdsGuardCounts{guard.statistics_removed.load(std::memory_order_relaxed),
                                      guard.statistics_misplaced.load(std::memory_order_relaxed),
                                      guard.send_channels_opened.load(std::memory_order_relaxed),
-                                     guard.destinations_skipped.load(std::memory_order_relaxed)};
+                                     guard.destinations_skipped.load(std::memory_order_relaxed),
+                                     guard.announcements_refused.load(std::memory_order_relaxed),
+                                     guard.leases_shortened.load(std::memory_order_relaxed)};
+  for (std::size_t reason = 0; reason < dds::kRtpsScreenReasons; ++reason)
+    metrics.dds_guard.screened_out[reason] = guard.screened_out[reason].load(std::memory_order_relaxed);
   metrics.link_last_change_s = link_last_change_s_;
   if (ingress_) {
     metrics.ingress_delay = ingress_->delay_histogram();

@@ -80,7 +80,13 @@ constexpr Family kDdsGuard{
     "What the DDS transport guard did: statistics_removed (the statistics submessage "
     "Fast DDS peers put last in every message), statistics_misplaced (one anywhere else: "
     "an attack), send_channel_opened (a reader locator Fast DDS had opened no channel for), "
-    "destination_skipped (no channel could be opened: not sent)"};
+    "destination_skipped (no channel could be opened: not sent), announcement_refused (a "
+    "participant more on probation than one source may have: a discovery flood), lease_shortened "
+    "(a new participant's announcement handed on with a 30 s lease until it is proven)"};
+constexpr Family kDdsScreen{
+    "rsg_dds_screen_dropped_total", Type::kCounter,
+    "RTPS messages the screen in front of Fast DDS refused, whole or from one submessage on, by "
+    "the check that failed (docs/fastdds-versions.md: each is a published Fast DDS flaw or its kind)"};
 constexpr Family kLinkUp{"rsg_link_up", Type::kGauge,
                          "1 while valid frames arrive within the link deadline, else 0"};
 constexpr Family kLinkChange{"rsg_link_last_change_timestamp_seconds", Type::kGauge,
@@ -126,6 +132,7 @@ constexpr std::array kFamilies = {&kBuildInfo,
                                   &kDumpFilesDeleted,
                                   &kDumpNotKept,
                                   &kDdsGuard,
+                                  &kDdsScreen,
                                   &kReloads,
                                   &kLinkUp,
                                   &kLinkChange,
@@ -316,6 +323,13 @@ std::string format_metrics(const MetricsSnapshot& snapshot, const std::optional<
   out.sample(kDdsGuard, snapshot.dds_guard.statistics_misplaced, "action=\"statistics_misplaced\"");
   out.sample(kDdsGuard, snapshot.dds_guard.send_channels_opened, "action=\"send_channel_opened\"");
   out.sample(kDdsGuard, snapshot.dds_guard.destinations_skipped, "action=\"destination_skipped\"");
+  out.sample(kDdsGuard, snapshot.dds_guard.announcements_refused, "action=\"announcement_refused\"");
+  out.sample(kDdsGuard, snapshot.dds_guard.leases_shortened, "action=\"lease_shortened\"");
+  out.family(kDdsScreen);
+  for (std::size_t reason = 0; reason < dds::kRtpsScreenReasons; ++reason) {
+    const auto name = dds::to_string(static_cast<dds::RtpsScreenReason>(reason));
+    out.sample(kDdsScreen, snapshot.dds_guard.screened_out[reason], "reason=\"" + std::string(name) + "\"");
+  }
   out.family(kReloads);
   out.sample(kReloads, snapshot.reloads.applied, "result=\"applied\"");
   out.sample(kReloads, snapshot.reloads.failed, "result=\"failed\"");

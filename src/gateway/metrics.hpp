@@ -5,6 +5,7 @@
 // the server's thread formats it when a scraper asks. Nothing here runs per frame.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -13,6 +14,7 @@
 
 #include "gateway/clock.hpp"
 #include "gateway/latency_histogram.hpp"
+#include "rsg/dds/rtps_guard.hpp"
 #include "status/stats.hpp"
 
 namespace rsg::gateway {
@@ -39,6 +41,10 @@ struct DdsGuardCounts {
   std::uint64_t statistics_misplaced = 0;
   std::uint64_t send_channels_opened = 0;
   std::uint64_t destinations_skipped = 0;
+  std::uint64_t announcements_refused = 0;
+  std::uint64_t leases_shortened = 0;
+  /// Messages the RTPS screen refused, by dds::RtpsScreenReason.
+  std::array<std::uint64_t, dds::kRtpsScreenReasons> screened_out{};
 };
 
 /// What one scrape reports: the gateway's counters as of the last status period or link change.

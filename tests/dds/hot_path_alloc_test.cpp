@@ -11,10 +11,13 @@
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+#include <memory>
 #include <random>
 #include <thread>
 
 #include "dds/internal/fastdds_compat.hpp"
+#include "dds/internal/rtps_screen.hpp"
+#include "dds/internal/spdp_admission.hpp"
 #include "rsg/dds/participant.hpp"
 #include "rsg/dds/profiles.hpp"
 #include "rsg/dds/robot_state.hpp"
@@ -56,6 +59,43 @@ TEST(HotPath, DecodeIntoASampleAllocatesNothing) {
     decoded += static_cast<bool>(codec.decode(frames[static_cast<std::size_t>(i) % frames.size()], sample));
   allocations.pause();
   EXPECT_EQ(decoded, static_cast<std::size_t>(kMeasured));
+  EXPECT_EQ(allocations.total(), 0U) << allocations.first_by_rsg();
+}
+
+/// An RTPS message as a reader of the gateway receives it: INFO_TS, a 2.1 kB DATA, a HEARTBEAT.
+std::vector<std::uint8_t> state_message() {
+  std::vector<std::uint8_t> m{'R', 'T', 'P', 'S', 2, 3, 0x01, 0x0f, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+  const auto sub = [&m](std::uint8_t id, std::uint8_t flags, std::vector<std::uint8_t> body) {
+    m.insert(m.end(), {id, flags, static_cast<std::uint8_t>(body.size()),
+                       static_cast<std::uint8_t>(body.size() >> 8)});
+    m.insert(m.end(), body.begin(), body.end());
+  };
+  sub(0x09, 0x01, std::vector<std::uint8_t>(8, 1));
+  std::vector<std::uint8_t> data{0, 0, 16, 0, 0, 0, 1, 7, 0, 0, 1, 2, 0, 0, 0, 0, 1, 0, 0, 0};
+  data.resize(data.size() + 2140, 0x5a);
+  sub(0x15, 0x05, data);
+  sub(0x07, 0x01, {0, 0, 1, 7, 0, 0, 1, 2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0});
+  return m;
+}
+
+// Every received datagram goes through the screen and the discovery admission (rtps_guard.cpp):
+// neither may allocate.
+TEST(HotPath, ScreeningAReceivedMessageAllocatesNothing) {
+  const auto message = state_message();
+  const auto size = static_cast<std::uint32_t>(message.size());
+  auto admission = std::make_unique<dds::internal::SpdpAdmission>();
+  const dds::internal::AnnouncementSource source{};
+  std::uint32_t forwarded = 0;
+  test::AllocationCounter allocations;
+  allocations.resume();
+  for (int i = 0; i < kMeasured; ++i) {
+    const auto screen = dds::internal::screen_rtps_datagram(message.data(), size);
+    forwarded += screen.forward_bytes == size;
+    admission->admit(message.data(), screen.forward_bytes, source,
+                     dds::internal::SpdpAdmission::Clock::now());
+  }
+  allocations.pause();
+  EXPECT_EQ(forwarded, static_cast<std::uint32_t>(kMeasured));
   EXPECT_EQ(allocations.total(), 0U) << allocations.first_by_rsg();
 }
 

@@ -1,7 +1,8 @@
 // The RTPS screen on arbitrary datagrams (src/dds/internal/rtps_screen.hpp): every rsg participant
 // runs it on every datagram it receives from the network, before Fast DDS's parser.
-//  - never reads outside the datagram, never hands on more than it got, cuts only at a statistics
-//    submessage;
+//  - never reads outside the datagram, never hands on more than it got, cuts only at a submessage
+//    boundary (a statistics submessage, or the first that fails a check);
+//  - what it hands on passes it again whole (every check holds on what Fast DDS reads);
 //  - what it hands on holds no statistics submessage that Fast DDS's own walk would read: the
 //    oracle below is that walk (MessageReceiver::notify_network_statistics and
 //    readSubmessageHeader, Fast DDS 2.9.1 to 3.1.2), written from its behaviour.
@@ -51,10 +52,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using Cut = rsg::dds::internal::RtpsScreen::Cut;
   if (screen.cut == Cut::kNone) {
     FUZZ_REQUIRE(screen.forward_bytes == bytes);
+  } else if (screen.cut == Cut::kInvalid) {
+    // Cut at a submessage boundary (or the whole datagram refused): never inside the header.
+    FUZZ_REQUIRE(screen.forward_bytes == 0 || (screen.forward_bytes >= 20 && screen.forward_bytes < bytes));
   } else {
     FUZZ_REQUIRE(screen.forward_bytes >= 20 && screen.forward_bytes < bytes);
     FUZZ_REQUIRE(datagram[screen.forward_bytes] == rsg::dds::internal::kStatisticsSubmessageId);
   }
+  if (screen.forward_bytes <= 20) return 0;  // dropped: Fast DDS sees nothing
   const std::vector<std::uint8_t> forwarded(datagram.begin(), datagram.begin() + screen.forward_bytes);
   FUZZ_REQUIRE(!fastdds_reads_statistics(forwarded.data(), screen.forward_bytes));
   // Screening is idempotent: what was handed on passes whole.

@@ -11,7 +11,8 @@ import time
 
 STATISTICS = 0x80
 VENDOR_EPROSIMA = b"\x01\x0f"
-GUARD_ACTIONS = ("statistics_removed", "statistics_misplaced", "send_channel_opened", "destination_skipped")
+GUARD_ACTIONS = ("statistics_removed", "statistics_misplaced", "send_channel_opened", "destination_skipped",
+                 "announcement_refused", "lease_shortened")
 
 # A participant profile as a site might write one: readers on a unicast and a multicast locator.
 # Fast DDS 2.9.1 to 3.1.2 then send to a locator they opened no channel for.
@@ -181,6 +182,22 @@ def spoof_participants(domain, count, ports, seed=39):
                 sender.sendto(datagram, ("127.0.0.1", port))
             if index % 50 == 49:
                 time.sleep(0.01)
+
+
+def spoof_participants_for(domain, count, ports, seconds, period_s, seed=40):
+    """The same `count` made-up participants re-announced every `period_s` for `seconds`, from one
+    socket: a sustained discovery flood."""
+    rng = random.Random(seed)
+    datagrams = [participant_announcement(domain, rng.randbytes(12), 42000 + index % 1000 * 2)
+                 for index in range(count)]
+    deadline = time.monotonic() + seconds
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
+        while time.monotonic() < deadline:
+            started = time.monotonic()
+            for datagram in datagrams:
+                for port in ports:
+                    sender.sendto(datagram, ("127.0.0.1", port))
+            time.sleep(max(0.0, period_s - (time.monotonic() - started)))
 
 
 def answers_new_participant(domain, listen_port, ports):
