@@ -39,9 +39,10 @@ WATCH_S = 1.5
 GATEWAY_GROWTH_LIMIT_KB = 32 * 1024
 RUNAWAY_KB = 1024 * 1024
 CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
-# What the control calls an effect in a probe that did not crash (an idle one: about 1 % of a core,
-# no growth): a core mostly busy (on a machine whose cores other work shares), memory growing.
-SPINNING_CPU = 30
+# What the control calls an effect in a probe that did not crash (an idle one: no thread runnable
+# more than a few % of the time, no growth): a thread that spins (runnable all the time, however
+# little of a core a loaded machine gives it), memory growing, discovery not answering.
+SPINNING_RUNNABLE = 50
 GROWING_MB_S = 20
 
 
@@ -62,6 +63,25 @@ def cpu_s(pid):
         return (int(fields[11]) + int(fields[12])) / CLOCK_TICKS
     except OSError:
         return 0.0
+
+
+def runnable_s(pid):
+    """{thread id: seconds it has been on a core or waiting for one} of process `pid`
+    (/proc/PID/task/*/schedstat): a thread that spins is runnable all the time, however little of a
+    core a loaded machine gives it; one that waits, hardly ever."""
+    threads = {}
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        try:
+            on_cpu, waiting = (task / "schedstat").read_text().split()[:2]
+            threads[task.name] = (int(on_cpu) + int(waiting)) / 1e9
+        except (OSError, ValueError):
+            pass
+    return threads
+
+
+def busiest_thread(before, after, elapsed_s):
+    """The largest share of `elapsed_s` one thread was runnable, from two runnable_s() snapshots."""
+    return max((after[tid] - before.get(tid, 0.0) for tid in after), default=0.0) / elapsed_s * 100
 
 
 def answers_new_participant(domain, ports, timeout_s=1.0):
@@ -107,7 +127,7 @@ class Control:
         ports = udp_ports_of(probe.pid)
         check(ports, f"{label} has no UDP port")
         time.sleep(0.2)  # its discovery threads past their start-up
-        cpu0, rss0, start = cpu_s(probe.pid), resident_kb(probe.pid), time.monotonic()
+        cpu0, runnable0, rss0, start = cpu_s(probe.pid), runnable_s(probe.pid), resident_kb(probe.pid), time.monotonic()
         attack(flaw, way, self.domain, ports)
         sent = time.monotonic()
         while time.monotonic() - sent < WATCH_S and probe.poll() is None:
@@ -123,12 +143,13 @@ class Control:
         else:
             elapsed = time.monotonic() - start
             cpu = (cpu_s(probe.pid) - cpu0) / elapsed * 100
+            runnable = busiest_thread(runnable0, runnable_s(probe.pid), elapsed)
             growth = (resident_kb(probe.pid) - rss0) / 1024 / elapsed
             answers = answers_new_participant(self.domain, ports)
-            measured = (f"{cpu:.0f} % of a core, resident memory {growth:+.0f} MB/s, "
-                        f"{'answers' if answers else 'no answer to'} a new participant")
-            busy = cpu >= SPINNING_CPU or growth >= GROWING_MB_S or not answers
-            effect = f"{'running on' if busy else 'no effect here'}: {measured}"
+            measured = (f"its busiest thread runnable {runnable:.0f} % of the time ({cpu:.0f} % of a core), resident memory "
+                        f"{growth:+.0f} MB/s, {'answers' if answers else 'no answer to'} a new participant")
+            busy = runnable >= SPINNING_RUNNABLE or growth >= GROWING_MB_S or not answers
+            effect = f"{'still running, but' if busy else 'no effect here'}: {measured}"
             crashed = False
             probe.kill()
             probe.wait()

@@ -124,18 +124,25 @@ def cve_2025_62799(prefix, reader, writer, sn):
             for i, size in enumerate((50009, 60010, 64011))]
 
 
+# The fragment size of the two flaws that make Fast DDS copy more than arrived: 1,000 fragments of
+# it are 16 MB, read from a receive buffer of 64 kB (far past its heap), and a sample under 16 MiB
+# (the largest a fragmented sample may be, for the screen: kMaxFragmentedSampleBytes), so that it is
+# the flaw's own check that refuses them.
+FRAGMENT = 16000
+
+
 def cve_2025_65865(prefix, reader, writer, sn):
     """DATA_FRAGs whose octetsToNextHeader (28) is smaller than their own header (32), so that the
-    payload length Fast DDS computes wraps to 2^32 - 4: each claims fragments 1 to 1,000 of 65,000
+    payload length Fast DDS computes wraps to 2^32 - 4: each claims fragments 1 to 1,000 of 16,000
     bytes (not the last: the sample is 1,001 fragments long) and holds none. Three of them."""
-    return [data_frag(prefix, sn + i, 1, 1000, 65000, 65000 * 1001, b"", length=DATA_FRAG_HEADER - 4,
+    return [data_frag(prefix, sn + i, 1, 1000, FRAGMENT, FRAGMENT * 1001, b"", length=DATA_FRAG_HEADER - 4,
                       reader=reader, writer=writer) for i in range(3)]
 
 
 def cve_2026_22590(prefix, reader, writer, sn):
-    """Fragments 1 to 1,000 of 65,000 bytes (the whole sample, the last one included) with 4 bytes of
+    """Fragments 1 to 1,000 of 16,000 bytes (the whole sample, the last one included) with 4 bytes of
     data: the last fragment's length is taken from the sample, not from what arrived. Three of them."""
-    return [data_frag(prefix, sn + i, 1, 1000, 65000, 65000 * 1000, b"\xa0\xa1\xa2\xa3", reader=reader,
+    return [data_frag(prefix, sn + i, 1, 1000, FRAGMENT, FRAGMENT * 1000, b"\xa0\xa1\xa2\xa3", reader=reader,
                       writer=writer) for i in range(3)]
 
 
