@@ -31,13 +31,15 @@ jobs=${JOBS:-$(nproc)}
 logs=$build/test-fastdds214
 integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors"
 integration+="|late_joiner|rate_topic|realtime_gateway|embedded_controller|dds_attacks|reader_teardown"
+# The published Fast DDS flaws, with their controls (what each does to a plain 2.14.5 participant).
+integration+="|fastdds_flaws"
 processes="views\.rsg_echo|integration\.($integration)|gateway\.embedded|cli\.rsg_frame|packaging\.install_consumer"
 processes+="|ros2\.(standard_topics|msg_matches_field_table)"
 # unit_tests_dds: the unit tests of the folders that use Fast DDS (those of wire, transport, capture,
 # mcap, foxglove and the simulator run in make test; no Fast DDS version changes them).
 targets=(unit_tests_dds rsg_gateway rsg_sim rsg_echo rsg_frame rsg_status_probe rsg_views_publish rsg_view
          rsg_example_embedded_controller rsg_ros2_standard_echo rsg_generate_msg rsg_record rsg_replay
-         rsg_embedded_gateway rsg_type_dump rsg_reader_teardown_probe)
+         rsg_embedded_gateway rsg_type_dump rsg_reader_teardown_probe rsg_fastdds_flaws_probe)
 
 suite=fastdds214
 source tests/support/suite_counts.sh

@@ -37,8 +37,9 @@ logs=$build/test-fastdds3
 integration="sim_to_echo|invalid_frames|sequence_and_link|raw_roundtrip|selection_request|startup_errors|late_joiner"
 integration+="|rate_topic|demo|realtime_gateway|embedded_controller"
 # The Fast DDS attacks (3.1.2 as Debian 13 built it aborted on both without rsg's guard; 3.6 has
-# upstream's fix of the second, the guard applies to both).
-integration+="|dds_attacks"
+# upstream's fix of the second, the guard applies to both), and the published Fast DDS flaws with
+# their controls (what each does to a plain participant of the chroot's Fast DDS).
+integration+="|dds_attacks|fastdds_flaws"
 # A data-sharing reader's delete that hangs (the control) and the egress reader's that does not.
 integration+="|reader_teardown"
 processes="views\.rsg_echo|interop\.cyclone|integration\.($integration)|ros2\.(standard_topics|msg_matches_field_table)"
@@ -49,7 +50,8 @@ processes+="|gateway\.embedded|cli\.rsg_frame|packaging\.install_consumer"
 # mcap, foxglove and the simulator run in make test; no Fast DDS version changes them).
 targets=(unit_tests_dds rsg_gateway rsg_sim rsg_echo rsg_frame rsg_status_probe rsg_views_publish rsg_view
          rsg_cyclone_echo rsg_cyclone_publish rsg_example_embedded_controller rsg_ros2_standard_echo
-         rsg_generate_msg rsg_record rsg_replay rsg_embedded_gateway rsg_reader_teardown_probe)
+         rsg_generate_msg rsg_record rsg_replay rsg_embedded_gateway rsg_reader_teardown_probe
+         rsg_fastdds_flaws_probe)
 
 suite=cross
 source tests/support/suite_counts.sh

@@ -22,7 +22,10 @@ over loopback and the host's /dev/shm (what docker/compose.yaml sets).
                 tests/support/dds_attacks.py from the host (the 84-byte statistics datagram on every
                 port of the domain, two readers of the image on a unicast and a multicast locator,
                 3,000 random RTPS datagrams): it keeps running and publishing, every reader gets its
-                samples, rsg_dds_guard_total counts what its guard did
+                samples, rsg_dds_guard_total counts what its guard did; then every published Fast
+                DDS flaw of tests/support/fastdds_flaws.py, unicast and to the discovery multicast
+                group (integration.fastdds_flaws has their controls): it keeps publishing, the
+                reader keeps its samples, and a reader started after them gets samples
   compose       docker/compose.yaml's services, run as the file says (docker compose with Docker;
                 with podman by compose_up, as Debian 12's podman-compose cannot run the file): the
                 gateway healthy, the echo's samples, the page on RSG_VIEW_PORT, the recording in the
@@ -53,6 +56,7 @@ from harness import (TestFailure, check, free_tcp_port, free_udp_port, read_json
 from metrics_support import http_get, parse_samples, value_of  # noqa: E402
 from dds_attacks import (TWO_LOCATORS_PROFILE, TWO_LOCATORS_XML, guard_counts, one_datagram,  # noqa: E402
                          random_datagrams, send_to_domain)
+from fastdds_flaws import attack_every  # noqa: E402
 
 # Where the image installs rsg's XML profiles (docker/Dockerfile: prefix /opt/rsg).
 IMAGE_PROFILES = "/opt/rsg/share/rsg/xml_profiles"
@@ -324,6 +328,21 @@ def dds_attacks(c):
     alive_and_publishing("3,000 random RTPS datagrams")
     check(plain.poll() is None, f"the plain reader ended: {c.stderr('plain')[-500:]}")
     print(f"[image] dds_attacks: the gateway kept publishing; guard {guard()}", flush=True)
+
+    # The published Fast DDS flaws (issue 46), each unicast and multicast.
+    def still_running(what):
+        check(gateway.poll() is None, f"the gateway container ended after {what}: {c.stderr('gateway')[-800:]}")
+        check(plain.poll() is None, f"the plain reader ended after {what}: {c.stderr('plain')[-500:]}")
+    samples = c.output("plain").read_text(errors="replace").count("\n")
+    sent = attack_every(int(c.domain), still_running)
+    alive_and_publishing("the published Fast DDS flaws")
+    wait_for(lambda: c.output("plain").read_text(errors="replace").count("\n") >= samples + 500,
+             "the plain reader to get 500 more samples after the published Fast DDS flaws", timeout_s=30)
+    c.start("late", "--domain", c.domain, "--json", "--count", "200", "--timeout", "30", entrypoint="rsg_echo")
+    check(c.wait("late", 60) == 0, f"a reader started after the published Fast DDS flaws did not get 200 samples: "
+          f"{c.stderr('late')[-500:]}")
+    print(f"[image] dds_attacks: the published Fast DDS flaws ({sent} datagrams): the gateway kept publishing, "
+          "the reader its samples, a reader started after them got 200", flush=True)
 
 
 def view_and_restart(c):

@@ -22,6 +22,10 @@ the ones before left:
                 statistics datagram on every port of the domain, two readers on a unicast and a
                 multicast locator, 3,000 random RTPS datagrams): the same process keeps running
                 (no restart), rsg_dds_guard_total counts what its guard did, frames arrive exact
+  fastdds_flaws every published Fast DDS flaw of tests/support/fastdds_flaws.py from the host,
+                unicast and to the discovery multicast group (integration.fastdds_flaws has their
+                controls): the same process keeps running (no restart), and a reader started after
+                them gets frames exact
   sigkill       the gateway killed with SIGKILL: systemd restarts it, and the same rsg_echo
                 receives the next frames exact
   watchdog      the gateway frozen with SIGSTOP: systemd's watchdog kills it ("Watchdog timeout" in
@@ -66,6 +70,7 @@ from harness import TestFailure, check, free_tcp_port, free_udp_port, read_json_
 from metrics_support import http_get, parse_samples, value_of  # noqa: E402
 from dds_attacks import (TWO_LOCATORS_PROFILE, TWO_LOCATORS_XML, guard_counts, one_datagram,  # noqa: E402
                          random_datagrams, send_to_domain)
+from fastdds_flaws import attack_every  # noqa: E402
 
 UNIT = "rsg-gateway@robot1.service"
 BROKEN = "rsg-gateway@broken.service"
@@ -399,6 +404,24 @@ class Run:
         check(self.echo.wait(timeout=60) == 0, f"rsg_echo exited non-zero: {self.echo_err.read_text()[-500:]}")
         print(f"[service] dds_attacks: pid {pid} kept running, no restart; guard {guard()}", flush=True)
 
+    def fastdds_flaws(self):
+        pid = self.box.main_pid()
+        restarts = self.box.show(UNIT, "NRestarts")
+
+        def same_process(what):
+            check(self.box.main_pid() == pid and self.box.show(UNIT, "ActiveState") == "active",
+                  f"the gateway did not survive {what}:\n{self.box.journal(UNIT)[-2000:]}")
+
+        sent = attack_every(self.domain, same_process)
+        check(self.box.show(UNIT, "NRestarts") == restarts, "systemd restarted the gateway after the published flaws")
+        self.sent = []
+        self.start_echo(FRAMES)
+        self.wait_matched(0)
+        self.send_and_check("fastdds_flaws")
+        check(self.echo.wait(timeout=60) == 0, f"rsg_echo exited non-zero: {self.echo_err.read_text()[-500:]}")
+        print(f"[service] fastdds_flaws: {sent} datagrams; pid {pid} kept running, no restart; a reader started "
+              "after them got every frame", flush=True)
+
     def sigkill(self):
         pid = self.box.main_pid()
         restarts = int(self.box.show(UNIT, "NRestarts"))
@@ -527,7 +550,7 @@ class Run:
 
 
 STEPS = ["install", "ready", "frames", "status_cause", "sigkill", "watchdog", "upgrade", "dds_attacks",
-         "ros2_type_hash", "broken", "purge"]
+         "fastdds_flaws", "ros2_type_hash", "broken", "purge"]
 
 
 def main():
