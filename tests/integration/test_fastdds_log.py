@@ -18,7 +18,7 @@ REJECTED = """<?xml version="1.0" encoding="UTF-8"?>
 <dds xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
   <profiles>
     <data_writer profile_name="rejected_writer">
-      <qos><deadline><period><sec>soon</sec></period></deadline></qos>
+      <qos><durability><kind>SOMETIMES</kind></durability></qos>
     </data_writer>
   </profiles>
 </dds>

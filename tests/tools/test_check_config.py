@@ -183,7 +183,7 @@ def expect_both(gateway, args, status, expected, shown):
 def main():
     if len(sys.argv) != 4:
         sys.exit(f"usage: {sys.argv[0]} RSG_GATEWAY PROFILES_DIR RSG_FASTDDS_FLAWS_PROBE")
-    gateway, profiles_dir, probe = sys.argv[1:]
+    gateway, profiles_dir, flaws_probe = sys.argv[1:]
     with tempfile.TemporaryDirectory() as tmp:
         listen = f"127.0.0.1:{test_port()}"
         metrics = f"127.0.0.1:{test_port()}"
@@ -337,7 +337,7 @@ def main():
             check(expected in err and err.count("\n") == 1, f"{shown} --check-config: stderr {err!r} lacks {expected!r}")
             check(out == "", f"{shown} --check-config wrote to stdout: {out!r}")
 
-        check_durations(gateway, profiles_dir, probe, listen, tmp)
+        check_durations(gateway, profiles_dir, flaws_probe, listen, tmp)
     if failures:
         sys.exit(f"{len(failures)} failed")
     print("--check-config: a good configuration 0 with its ports free after, ports a start cannot have 1, "
