@@ -546,6 +546,10 @@ ConfigResult parse_gateway_config(std::string_view yaml_text, const GatewayConfi
         return ConfigError{line, name + ": " + error};
       given.emplace_back(key, line);
     }
+    // An instance's partition (instance_defaults) is a default a ROS 2 file does not want: ROS 2
+    // tells robots apart by namespace, so `ros2: true` without a `partition:` line drops it.
+    if (config.ros2 && !seen.contains("partition") && config.partition == defaults.partition)
+      config.partition.clear();
     for (const auto& [key, line] : given)
       if (auto error = key->check(config); !error.empty())
         return ConfigError{line, std::string(key->name) + ": " + error};

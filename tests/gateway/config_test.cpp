@@ -128,6 +128,11 @@ TEST(GatewayConfig, AnInstanceNamesItsPartitionAndTheUnitsDirectories) {
   ASSERT_TRUE(parsed);
   EXPECT_EQ(parsed.config().partition, "robot1");
   EXPECT_EQ(parsed.config().stats_file, "/run/rsg/robot2/stats.json");
+  // A ROS 2 instance: ROS 2 uses no partitions, so the instance's gives way (the unit's ros2 file).
+  const ConfigResult ros2 = parse_gateway_config("ros2: true\n", config);
+  ASSERT_TRUE(ros2) << ros2.error().message;
+  EXPECT_EQ(ros2.config().partition, "");
+  EXPECT_FALSE(parse_gateway_config("ros2: true\npartition: robot1\n", config));
   for (const char* bad : {"", ".", "..", "a/b"})
     EXPECT_TRUE(std::holds_alternative<std::string>(instance_defaults(bad)));
 }
