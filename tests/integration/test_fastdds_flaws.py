@@ -1,5 +1,5 @@
 """No published Fast DDS flaw reaches the gateway (issue 46; docs/fastdds-versions.md, "Published
-Fast DDS flaws").
+Fast DDS flaws, as tested").
 
 Each flaw of tests/support/fastdds_flaws.py, sent as a made-up participant would, unicast to every
 port of the domain and to its discovery multicast group, on loopback; the DATA_FRAG ones also from a
@@ -8,8 +8,8 @@ user reader listens on the multicast port):
 
   1. the control: against rsg_fastdds_flaws_probe, a plain Fast DDS participant with a reader (none
      of rsg's defences), alone on a DDS domain of its own: what the flaw does to the Fast DDS this
-     build links, measured and printed (a signal, a core busy, resident memory growing, no answer
-     to a new participant within 1 s) or "no effect here". On Fast DDS 2.9 (Debian 12, the default
+     build links, measured and printed (a signal, a thread spinning, resident memory growing, no
+     answer to a new participant within 1 s) or "no effect here". On Fast DDS 2.9 (Debian 12, the default
      build) the three crash rows must crash it, unicast and multicast: else the test no longer shows
      what it says;
   2. against rsg: a gateway fed at 1 kHz by rsg_sim, with rsg_echo, rsg_record and rsg_view reading
@@ -34,8 +34,9 @@ from fastdds_flaws import FLAWS, attack
 
 # How long the control watches the probe after an attack: every crash seen on 2.9.1 came within 1 s.
 WATCH_S = 1.5
-# What the gateway's resident memory may grow by over every attack (the screen drops them; Fast DDS
-# without it grew by 280 MB/s and more), and the size at which the test stops at once.
+# What the gateway's resident memory may grow by over every attack (the screen drops them: about
+# 0.5 MB seen; Fast DDS without it grew by hundreds of MB/s), and the size at which the test stops
+# at once.
 GATEWAY_GROWTH_LIMIT_KB = 32 * 1024
 RUNAWAY_KB = 1024 * 1024
 CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
