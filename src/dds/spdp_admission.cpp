@@ -7,7 +7,6 @@
 namespace rsg::dds::internal {
 namespace {
 
-
 /// How long a participant not heard from keeps its place in the table.
 constexpr std::chrono::seconds kForgetAfter{60};
 constexpr std::uint32_t kProbeWindow = 32;

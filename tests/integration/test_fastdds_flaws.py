@@ -22,14 +22,13 @@ By hand: RSG_FLAWS_ONLY=control (or rsg) runs one half; RSG_FLAWS_ROWS=CVE-2025-
 
 import os
 import signal
-import socket
 import sys
 import time
 from pathlib import Path
 
 from harness import acquire_domain, check, free_tcp_port, free_udp_port, main, read_json, wait_for, wait_for_stats
 from metrics_support import http_get, parse_samples
-from dds_attacks import participant_announcement, udp_ports_of
+from dds_attacks import answers_new_participant, participant_announcement, udp_ports_of
 from fastdds_flaws import FLAWS, attack
 
 # How long the control watches the probe after an attack: every crash seen on 2.9.1 came within 1 s.
@@ -85,22 +84,6 @@ def busiest_thread(before, after, elapsed_s):
     return max((after[tid] - before.get(tid, 0.0) for tid in after), default=0.0) / elapsed_s * 100
 
 
-def answers_new_participant(domain, ports, timeout_s=1.0):
-    """Whether a participant listening on `ports` answers a new participant's announcement (with its
-    own, to the newcomer's metatraffic locator) within `timeout_s`: whether its discovery still works."""
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as listener, \
-            socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
-        listener.bind(("127.0.0.1", free_udp_port()))
-        listener.settimeout(timeout_s)
-        announcement = participant_announcement(domain, os.urandom(12), listener.getsockname()[1])
-        for port in ports:
-            sender.sendto(announcement, ("127.0.0.1", port))
-        try:
-            return listener.recvfrom(65536)[0].startswith(b"RTPS")
-        except socket.timeout:
-            return False
-
-
 def signal_name(status):
     try:
         return signal.Signals(-status).name
@@ -146,7 +129,7 @@ class Control:
             cpu = (cpu_s(probe.pid) - cpu0) / elapsed * 100
             runnable = busiest_thread(runnable0, runnable_s(probe.pid), elapsed)
             growth = (resident_kb(probe.pid) - rss0) / 1024 / elapsed
-            answers = answers_new_participant(self.domain, ports)
+            answers = answers_new_participant(self.domain, free_udp_port(), ports, timeout_s=1.0)
             measured = (f"its busiest thread runnable {runnable:.0f} % of the time ({cpu:.0f} % of a core), resident memory "
                         f"{growth:+.0f} MB/s, {'answers' if answers else 'no answer to'} a new participant")
             busy = runnable >= SPINNING_RUNNABLE or growth >= GROWING_MB_S or not answers

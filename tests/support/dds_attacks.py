@@ -200,13 +200,13 @@ def spoof_participants_for(domain, count, ports, seconds, period_s, seed=40):
             time.sleep(max(0.0, period_s - (time.monotonic() - started)))
 
 
-def answers_new_participant(domain, listen_port, ports):
+def answers_new_participant(domain, listen_port, ports, timeout_s=3.0):
     """True when a participant listening on `ports` answers a new participant's announcement (it sends
-    its own to the newcomer's metatraffic locator, 127.0.0.1:`listen_port`) within 3 s."""
+    its own to the newcomer's metatraffic locator, 127.0.0.1:`listen_port`) within `timeout_s`."""
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as listener, \
             socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
         listener.bind(("127.0.0.1", listen_port))
-        listener.settimeout(3.0)
+        listener.settimeout(timeout_s)
         announcement = participant_announcement(domain, random.randbytes(12), listen_port)
         for port in ports:
             sender.sendto(announcement, ("127.0.0.1", port))
