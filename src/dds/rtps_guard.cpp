@@ -335,6 +335,10 @@ void bound_discovery(eprosima::fastdds::dds::DomainParticipantQos& qos) {
   if (allocation.participants.maximum == unbounded) allocation.participants.maximum = kMaxRemoteParticipants;
   if (allocation.readers.maximum == unbounded) allocation.readers.maximum = kMaxEndpointsPerRemoteParticipant;
   if (allocation.writers.maximum == unbounded) allocation.writers.maximum = kMaxEndpointsPerRemoteParticipant;
+  auto& limits = allocation.data_limits;  // 0: unbounded
+  if (limits.max_user_data == 0) limits.max_user_data = kMaxAnnouncedUserDataBytes;
+  if (limits.max_partitions == 0) limits.max_partitions = kMaxAnnouncedPartitionBytes;
+  if (limits.max_properties == 0) limits.max_properties = kMaxAnnouncedPropertyBytes;
 }
 
 }  // namespace rsg::dds::internal

@@ -209,6 +209,7 @@ std::optional<Reason> check_parameter(std::uint16_t pid, const Span& value,
       valid = duration_valid(value, 4);  // kind, then the duration
       break;
     case kPidPartition:
+      if (value.size() > kMaxAnnouncedPartitionBytes + 4) return Reason::kAnnouncedTooMuch;
       valid = whole(skip_strings(value, 0));  // CVE-2026-55063
       break;
     case kPidContentFilterProperty: {
@@ -218,8 +219,9 @@ std::optional<Reason> check_parameter(std::uint16_t pid, const Span& value,
       break;
     }
     case kPidUserData:
-    case kPidGroupData:
+    case kPidGroupData:  // kept whole as well, and with no data_limit of Fast DDS's
     case kPidTopicData:
+      if (value.size() >= 4 && value.u32(0) > kMaxAnnouncedUserDataBytes) return Reason::kAnnouncedTooMuch;
       valid = whole(skip_octets(value, 0));
       break;
     case kPidUnicastLocator:
@@ -232,6 +234,7 @@ std::optional<Reason> check_parameter(std::uint16_t pid, const Span& value,
       if (!locators.add(pid)) return Reason::kTooManyLocators;
       break;
     case kPidPropertyList: {  // CVE-2026-53590
+      if (value.size() > kMaxAnnouncedPropertyBytes + 4) return Reason::kAnnouncedTooMuch;
       // Properties, then (DDS Security 1.1, 7.2.1: PropertyQosPolicy) binary properties when bytes
       // are left: Fast DDS sends none, Wireshark reads them, so they must hold too.
       auto next = skip_properties(value, 0, false);

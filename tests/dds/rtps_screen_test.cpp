@@ -310,6 +310,36 @@ TEST(RtpsScreen, StringsDurationsAndLocators) {
                     pl_payload(spdp_parameters(parameter(0x0023, u32s({0x7fffffff, 0xffffffff})))))}));
 }
 
+// Fast DDS keeps what an announcement carries, and keeps a sample it refuses for its size: the
+// screen refuses user data, partitions and properties over rsg's data_limits first.
+TEST(RtpsScreen, AnnouncementsThatCarryMoreThanAParticipantKeeps) {
+  using rsg::dds::internal::kMaxAnnouncedUserDataBytes;
+  const auto octets = [](std::uint32_t size) {
+    Bytes value = u32s({size});
+    value.resize(4 + size, 0xab);
+    return value;
+  };
+  // ROS 2's type hash, and user data at the limit, pass.
+  expect_whole(
+      message({data(kSpdpReader, kSpdpWriter,
+                    pl_payload(spdp_parameters(parameter(0x002c, cdr_string(std::string(80, 'h'))))))}));
+  expect_whole(
+      message({data(kSpdpReader, kSpdpWriter,
+                    pl_payload(spdp_parameters(parameter(0x002c, octets(kMaxAnnouncedUserDataBytes)))))}));
+  for (const std::uint16_t pid : {0x002c, 0x002d, 0x002e})  // user, group, topic data
+    expect_spdp_cut(parameter(pid, octets(kMaxAnnouncedUserDataBytes + 1)),
+                    RtpsScreenReason::kAnnouncedTooMuch);
+  Bytes partitions = u32s({200});
+  for (int i = 0; i < 200; ++i) append(partitions, cdr_string("partition"));
+  expect_spdp_cut(parameter(0x0029, partitions), RtpsScreenReason::kAnnouncedTooMuch);
+  Bytes properties = u32s({100});
+  for (int i = 0; i < 100; ++i) {
+    append(properties, cdr_string("fastdds.property"));
+    append(properties, cdr_string("value"));
+  }
+  expect_spdp_cut(parameter(0x0059, properties), RtpsScreenReason::kAnnouncedTooMuch);
+}
+
 Bytes from_hex(const std::string& hex) {
   Bytes out;
   for (std::size_t i = 0; i + 1 < hex.size(); i += 2)

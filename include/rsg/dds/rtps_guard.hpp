@@ -37,8 +37,9 @@ enum class RtpsScreenReason : std::uint8_t {
   kTooManyLocators,    ///< an announcement with more locators than kMaxLocatorsPerAnnouncement
   kBuiltinPayload,     ///< a built-in sample that is not a parameter list, not well-formed
   kUnknownSubmessage,  ///< a submessage id RTPS 2.5 and DDS Security do not define (below 0x80)
+  kAnnouncedTooMuch,   ///< user data, partitions or properties over what an rsg participant keeps
 };
-inline constexpr std::size_t kRtpsScreenReasons = 17;
+inline constexpr std::size_t kRtpsScreenReasons = 18;
 
 /// The label of each reason on /metrics (`rsg_dds_screen_dropped_total{reason="..."}`).
 constexpr std::string_view to_string(RtpsScreenReason reason) noexcept {
@@ -46,11 +47,11 @@ constexpr std::string_view to_string(RtpsScreenReason reason) noexcept {
   constexpr std::array<std::string_view, kRtpsScreenReasons> names{
       "not_rtps", "submessage_length", "data", "data_frag", "fragmented_builtin", "sample_too_large",
       "gap", "heartbeat", "acknack", "nack_frag", "info", "inline_qos", "param_list", "param_value",
-      "locators", "builtin_payload", "unknown_submessage"};
+      "locators", "builtin_payload", "unknown_submessage", "announced_too_much"};
   // clang-format on
   return names[static_cast<std::size_t>(reason)];
 }
-static_assert(to_string(RtpsScreenReason::kUnknownSubmessage) == "unknown_submessage",
+static_assert(to_string(RtpsScreenReason::kAnnouncedTooMuch) == "announced_too_much",
               "one name per reason, in the enum's order");
 
 /// Shared by the guarded transports of one participant; read from any thread.

@@ -18,7 +18,8 @@ void guard_transports(eprosima::fastdds::dds::DomainParticipantQos& qos,
 
 /// How much of other participants' discovery data a participant keeps, where `qos` leaves it
 /// unbounded (Fast DDS's default): spoofed announcements, each a new participant with the longest
-/// lease, would otherwise grow the process without end (docs/configuration.md, "Limits").
+/// lease, would otherwise grow the process without end (docs/configuration.md, "Limits"). The bytes
+/// of user data, partitions and properties of each are the screen's (kMaxAnnouncedUserDataBytes...).
 inline constexpr std::size_t kMaxRemoteParticipants = 256;
 inline constexpr std::size_t kMaxEndpointsPerRemoteParticipant = 128;  ///< readers, and writers
 void bound_discovery(eprosima::fastdds::dds::DomainParticipantQos& qos);

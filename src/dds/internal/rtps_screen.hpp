@@ -45,6 +45,15 @@ inline constexpr std::int64_t kMaxBuiltinGapRange = std::int64_t{1} << 16;
 /// Fast DDS keeps 4 unicast and 1 multicast per remote endpoint by default and sends a copy of
 /// every sample to each: an announcement with more is an amplification attempt, not a host.
 inline constexpr std::uint32_t kMaxLocatorsPerAnnouncement = 8;
+/// The bytes of user data (and of group and topic data), of partition names and of properties (each
+/// parameter's value) one announcement may carry. Fast DDS keeps every remote endpoint's announcement whole,
+/// by default without a bound (120 writers with 60 kB of user data each held 7 MB of a plain participant);
+/// given these as its data_limits it refuses a larger one, but keeps the refused sample in its discovery
+/// reader's history for as long as the sender's participant lives (its listener removes a sample
+/// only once it has read it: 2.9.1 to 3.6.1), so the screen refuses it first. ROS 2 announces about 80 bytes of user data per endpoint (its type hash).
+inline constexpr std::uint32_t kMaxAnnouncedUserDataBytes = 1024;
+inline constexpr std::uint32_t kMaxAnnouncedPartitionBytes = 1024;
+inline constexpr std::uint32_t kMaxAnnouncedPropertyBytes = 2048;
 
 struct RtpsScreen {
   enum class Cut : std::uint8_t {
