@@ -182,6 +182,55 @@ struct LocatorCounts {
   }
 };
 
+/// The size of a standard parameter that Fast DDS reads as a fixed-size value (0: none), from
+/// ParameterSerializer and QosPoliciesSerializer. Vendor-specific ids (0x8000 and up) mean different
+/// things from different vendors and are left out.
+constexpr std::uint32_t fixed_size(std::uint16_t pid) noexcept {
+  switch (pid) {
+    case kPidProtocolVersion:
+    case kPidVendorId:
+    case kPidDurability:
+    case kPidOwnership:
+    case kPidOwnershipStrength:
+    case kPidDestinationOrder:
+    case kPidTransportPriority:
+    case kPidBuiltinEndpointSet:
+    case kPidExpectsInlineQos:
+    case kPidStatusInfo:
+      return 4;
+    case kPidLeaseDuration:
+    case kPidTimeBasedFilter:
+    case kPidDeadline:
+    case kPidLatencyBudget:
+    case kPidLifespan:
+    case kPidPresentation:
+    case kPidHistory:
+    case kPidEndpointSecurityInfo:
+    case kPidParticipantSecurityInfo:
+      return 8;
+    case kPidReliability:
+    case kPidLiveliness:
+    case kPidResourceLimits:
+      return 12;
+    case kPidParticipantGuid:
+    case kPidEndpointGuid:
+    case kPidGroupGuid:
+    case kPidKeyHash:
+      return 16;
+    case kPidUnicastLocator:
+    case kPidMulticastLocator:
+    case kPidDefaultUnicastLocator:
+    case kPidDefaultMulticastLocator:
+    case kPidMetatrafficUnicastLocator:
+    case kPidMetatrafficMulticastLocator:
+      return kLocatorBytes;
+    case kPidDurabilityService:
+      return 28;
+    default:
+      return 0;
+  }
+}
+
 /// The value of one parameter, as Fast DDS's fixed deserializers bound it. Parameters rsg does not
 /// name here are left to Fast DDS, which reads them within their length.
 std::optional<Reason> check_parameter(std::uint16_t pid, const Span& value,
@@ -189,6 +238,9 @@ std::optional<Reason> check_parameter(std::uint16_t pid, const Span& value,
   const auto whole = [&](std::optional<std::uint32_t> end) {
     return end.has_value() && *end <= value.size();
   };
+  if (const std::uint32_t size = fixed_size(pid);
+      size != 0 && (value.size() < size || (kExactParameterLengths && value.size() != size)))
+    return Reason::kParameterValue;
   bool valid = true;
   switch (pid) {
     case kPidTopicName:
@@ -230,7 +282,6 @@ std::optional<Reason> check_parameter(std::uint16_t pid, const Span& value,
     case kPidDefaultMulticastLocator:
     case kPidMetatrafficUnicastLocator:
     case kPidMetatrafficMulticastLocator:
-      if (value.size() < kLocatorBytes) return Reason::kParameterValue;
       if (!locators.add(pid)) return Reason::kTooManyLocators;
       break;
     case kPidPropertyList: {  // CVE-2026-53590
@@ -246,12 +297,6 @@ std::optional<Reason> check_parameter(std::uint16_t pid, const Span& value,
     case kPidPermissionsToken:
     case kPidIdentityStatusToken:
       valid = whole(skip_data_holder(value, 0));
-      break;
-    case kPidKeyHash:
-      valid = value.size() >= 16;
-      break;
-    case kPidStatusInfo:
-      valid = value.size() >= 4;
       break;
     case kPidDataRepresentation:  // CVE-2026-49861: a count of 0xFFFFFFFF
       valid = bounded_count(value, 0, 2).has_value();

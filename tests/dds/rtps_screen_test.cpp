@@ -340,6 +340,31 @@ TEST(RtpsScreen, AnnouncementsThatCarryMoreThanAParticipantKeeps) {
   expect_spdp_cut(parameter(0x0059, properties), RtpsScreenReason::kAnnouncedTooMuch);
 }
 
+// Fast DDS 2.9 refuses a fixed-size parameter of another length, 2.14 and 3.x a shorter one, and
+// keeps the announcement it could not read: the screen refuses it first.
+TEST(RtpsScreen, FixedSizeParametersOfAnotherLength) {
+  expect_spdp_cut(parameter(0x001a, u32s({2, 0})),
+                  RtpsScreenReason::kParameterValue);  // reliability: 8 of 12
+  expect_spdp_cut(parameter(0x005a, Bytes(12, 1)),
+                  RtpsScreenReason::kParameterValue);  // endpoint GUID: 12 of 16
+  expect_spdp_cut(parameter(0x001e, Bytes(24, 0)), RtpsScreenReason::kParameterValue);  // durability service
+  const Bytes longer = parameter(0x001d, u32s({1, 0}));                                 // durability: 8 of 4
+  if (rsg::dds::internal::kExactParameterLengths)
+    expect_spdp_cut(longer, RtpsScreenReason::kParameterValue);
+  else
+    expect_whole(message({data(kSpdpReader, kSpdpWriter, pl_payload(spdp_parameters(longer)))}));
+  // The sizes Fast DDS sends pass.
+  Bytes qos;
+  append(qos, parameter(0x001d, u32s({1})));           // durability
+  append(qos, parameter(0x001a, u32s({2, 0, 1000})));  // reliability
+  append(qos, parameter(0x001e, Bytes(28, 0)));        // durability service
+  append(qos, parameter(0x0021, Bytes(8, 0)));         // presentation
+  append(qos, parameter(0x0040, u32s({0, 1})));        // history
+  append(qos, parameter(0x005a, Bytes(16, 0xa5)));     // endpoint GUID
+  append(qos, parameter(0x1004, u32s({0, 0})));        // endpoint security info
+  expect_whole(message({data(kSpdpReader, kSpdpWriter, pl_payload(spdp_parameters(qos)))}));
+}
+
 Bytes from_hex(const std::string& hex) {
   Bytes out;
   for (std::size_t i = 0; i + 1 < hex.size(); i += 2)

@@ -23,13 +23,18 @@ test in eProsima/Fast-DDS: which submessage, which field, which values), not fro
                   DATA(w)/DATA(r) parameter drive push_back loops, bounded by nothing:
                   PID_DATA_REPRESENTATION's count and PID_DATASHARING's number of domains.
 
-And one that is no flaw of Fast DDS's parser but of its defaults, found for rsg (issue 46, "bounded
-whatever gets through"):
+And two found for rsg, published nowhere (issue 46, "bounded whatever gets through"):
 
   bulky-endpoints Fast DDS keeps every remote endpoint's announcement whole, its user data among it,
                   by default without a bound: 120 writers of one made-up participant, each with
                   60,000 bytes of user data (what a datagram holds), are 7 MB of the victim's memory,
                   and 256 such participants 1.8 GB. rsg's participants bound it (data_limits).
+  refused-announcements  a discovery sample Fast DDS cannot read (one parameter of another length
+                  than it reads, here PID_DURABILITY) is left in its discovery reader's history
+                  until the sender's participant goes (its listener removes only what it read; the
+                  code of 2.9.1 to 3.6.1 and of master in August 2026): one made-up participant's
+                  DATA(w) of 60 kB, each with a sequence number of its own, grow the victim without
+                  end (7 MB per 120 of them).
 
 Each flaw is in a reader, for a writer Fast DDS has matched: each attack first announces a made-up
 participant (one SPDP DATA(p), tests/support/dds_attacks.py), then speaks as that participant's
@@ -184,6 +189,22 @@ def bulky_endpoints(prefix, _reader, _writer, sn):
             for i in range(BULKY_WRITERS)]
 
 
+# What refused_announcements sends: DATA(w) per made-up participant, and the bytes each carries in a
+# parameter no reader knows (which Fast DDS skips).
+REFUSED_ANNOUNCEMENTS = 120
+REFUSED_PADDING = 60000
+
+
+def refused_announcements(prefix, _reader, _writer, sn):
+    """REFUSED_ANNOUNCEMENTS DATA(w), each a writer of its own, each carrying REFUSED_PADDING bytes in
+    an unknown parameter (0x3ff0) and a PID_DURABILITY of 8 bytes where Fast DDS reads 4: a sample
+    Fast DDS refuses to read, and keeps in its discovery reader's history."""
+    padding = (0x3FF0, bytes(REFUSED_PADDING))
+    durability = (0x001D, struct.pack("<II", 0, 0))
+    return [publication(prefix, sn + i, [padding, durability], writer=struct.pack(">I", (i + 1) << 8 | 0x03))
+            for i in range(REFUSED_ANNOUNCEMENTS)]
+
+
 class Flaw:
     """One published flaw sent to one kind of reader: `target` "spdp" (the built-in participant
     reader, as the participant's own SPDP writer), "sedp" (the built-in publications reader, as its
@@ -233,6 +254,9 @@ FLAWS = [
          cve_2026_49861, "sedp"),
     Flaw("bulky-endpoints", f"{BULKY_WRITERS} DATA(w) of one made-up participant, each with {BULKY_USER_DATA} "
          "bytes of user data", "held", bulky_endpoints, "sedp"),
+    Flaw("refused-announcements", f"{REFUSED_ANNOUNCEMENTS} DATA(w) of one made-up participant that Fast DDS "
+         f"refuses to read (a PID_DURABILITY of 8 bytes), each with {REFUSED_PADDING} bytes of an unknown parameter",
+         "held", refused_announcements, "sedp"),
     Flaw("CVE-2025-62799", "the same DATA_FRAGs, from a writer of robot_state", "bounded", cve_2025_62799, "user"),
     Flaw("CVE-2025-65865", "the same DATA_FRAGs, from a writer of robot_state", "bounded", cve_2025_65865, "user"),
     Flaw("CVE-2026-22590", "the same DATA_FRAGs, from a writer of robot_state", "bounded", cve_2026_22590, "user"),

@@ -69,6 +69,25 @@ inline constexpr std::uint16_t kPidIdentityToken = 0x1001;
 inline constexpr std::uint16_t kPidPermissionsToken = 0x1002;
 inline constexpr std::uint16_t kPidIdentityStatusToken = 0x1006;
 inline constexpr std::uint16_t kPidDataSharing = 0x8006;
+// Standard parameters of fixed size (RTPS 2.5, 9.6.2.2.2; DDS Security 1.1, 7.4.1.6).
+inline constexpr std::uint16_t kPidOwnershipStrength = 0x0006;
+inline constexpr std::uint16_t kPidProtocolVersion = 0x0015;
+inline constexpr std::uint16_t kPidVendorId = 0x0016;
+inline constexpr std::uint16_t kPidDurability = 0x001d;
+inline constexpr std::uint16_t kPidDurabilityService = 0x001e;
+inline constexpr std::uint16_t kPidOwnership = 0x001f;
+inline constexpr std::uint16_t kPidPresentation = 0x0021;
+inline constexpr std::uint16_t kPidDestinationOrder = 0x0025;
+inline constexpr std::uint16_t kPidHistory = 0x0040;
+inline constexpr std::uint16_t kPidResourceLimits = 0x0041;
+inline constexpr std::uint16_t kPidExpectsInlineQos = 0x0043;
+inline constexpr std::uint16_t kPidTransportPriority = 0x0049;
+inline constexpr std::uint16_t kPidParticipantGuid = 0x0050;
+inline constexpr std::uint16_t kPidGroupGuid = 0x0052;
+inline constexpr std::uint16_t kPidBuiltinEndpointSet = 0x0058;
+inline constexpr std::uint16_t kPidEndpointGuid = 0x005a;
+inline constexpr std::uint16_t kPidEndpointSecurityInfo = 0x1004;
+inline constexpr std::uint16_t kPidParticipantSecurityInfo = 0x1005;
 inline constexpr std::uint32_t kLocatorBytes = 24;  // kind, port, 16-byte address
 
 // Built-in entity ids (RTPS 2.5, 9.3.1.4).

@@ -24,6 +24,14 @@
 
 #include "rsg/dds/rtps_guard.hpp"
 
+// The version of the Fast DDS this screen stands in front of (macros only: nothing of Fast DDS is
+// called here).
+#if __has_include(<fastdds/config.hpp>)
+#include <fastdds/config.hpp>
+#else
+#include <fastrtps/config.h>
+#endif
+
 namespace rsg::dds::internal {
 
 /// The eProsima vendor-specific submessage that carries network statistics.
@@ -50,10 +58,21 @@ inline constexpr std::uint32_t kMaxLocatorsPerAnnouncement = 8;
 /// by default without a bound (120 writers with 60 kB of user data each held 7 MB of a plain participant);
 /// given these as its data_limits it refuses a larger one, but keeps the refused sample in its discovery
 /// reader's history for as long as the sender's participant lives (its listener removes a sample
-/// only once it has read it: 2.9.1 to 3.6.1), so the screen refuses it first. ROS 2 announces about 80 bytes of user data per endpoint (its type hash).
+/// only once it has read it: 2.9.1 to 3.6.1), so the screen refuses it first. ROS 2 announces about 80 bytes
+/// of user data per endpoint (its type hash).
 inline constexpr std::uint32_t kMaxAnnouncedUserDataBytes = 1024;
 inline constexpr std::uint32_t kMaxAnnouncedPartitionBytes = 1024;
 inline constexpr std::uint32_t kMaxAnnouncedPropertyBytes = 2048;
+
+/// Whether a standard parameter of fixed size must have exactly its size, or at least it: Fast DDS
+/// 2.9 refuses any other length, 2.14 and 3.x only a shorter one (ParameterSerializer,
+/// QosPoliciesSerializer). A refused parameter leaves the whole announcement unread, and Fast DDS
+/// keeps an unread discovery sample (kMaxAnnouncedUserDataBytes), so the screen refuses it first.
+#if defined(FASTRTPS_VERSION_MAJOR) && FASTRTPS_VERSION_MAJOR == 2 && FASTRTPS_VERSION_MINOR < 14
+inline constexpr bool kExactParameterLengths = true;
+#else
+inline constexpr bool kExactParameterLengths = false;
+#endif
 
 struct RtpsScreen {
   enum class Cut : std::uint8_t {
