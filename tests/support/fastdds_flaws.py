@@ -197,10 +197,11 @@ REFUSED_PADDING = 60000
 
 def refused_announcements(prefix, _reader, _writer, sn):
     """REFUSED_ANNOUNCEMENTS DATA(w), each a writer of its own, each carrying REFUSED_PADDING bytes in
-    an unknown parameter (0x3ff0) and a PID_DURABILITY of 8 bytes where Fast DDS reads 4: a sample
-    Fast DDS refuses to read, and keeps in its discovery reader's history."""
+    an unknown parameter (0x3ff0) and an empty PID_DURABILITY where Fast DDS reads 4 bytes (2.9
+    refuses any other length, 2.14 and 3.x a shorter one): a sample Fast DDS refuses to read, and
+    keeps in its discovery reader's history."""
     padding = (0x3FF0, bytes(REFUSED_PADDING))
-    durability = (0x001D, struct.pack("<II", 0, 0))
+    durability = (0x001D, b"")
     return [publication(prefix, sn + i, [padding, durability], writer=struct.pack(">I", (i + 1) << 8 | 0x03))
             for i in range(REFUSED_ANNOUNCEMENTS)]
 
@@ -255,7 +256,7 @@ FLAWS = [
     Flaw("bulky-endpoints", f"{BULKY_WRITERS} DATA(w) of one made-up participant, each with {BULKY_USER_DATA} "
          "bytes of user data", "held", bulky_endpoints, "sedp"),
     Flaw("refused-announcements", f"{REFUSED_ANNOUNCEMENTS} DATA(w) of one made-up participant that Fast DDS "
-         f"refuses to read (a PID_DURABILITY of 8 bytes), each with {REFUSED_PADDING} bytes of an unknown parameter",
+         f"refuses to read (an empty PID_DURABILITY), each with {REFUSED_PADDING} bytes of an unknown parameter",
          "held", refused_announcements, "sedp"),
     Flaw("CVE-2025-62799", "the same DATA_FRAGs, from a writer of robot_state", "bounded", cve_2025_62799, "user"),
     Flaw("CVE-2025-65865", "the same DATA_FRAGs, from a writer of robot_state", "bounded", cve_2025_65865, "user"),
